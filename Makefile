@@ -1,0 +1,34 @@
+# cvg_bench: two-command setup on Debian 12. `make demo` runs the main job, `make test` runs all tests.
+# The catkin workspace lives under build/ (ignored by git); the repository is its only package.
+SHELL := /bin/bash
+WS := build/ws
+JOBS ?= 2
+export PATH := /usr/bin:/bin:$(PATH)
+CATKIN_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release -DCATKIN_ENABLE_TESTING=ON
+
+.PHONY: deps build demo test bench format clean
+
+deps:
+	@bash scripts/install_deps.sh
+
+build: deps
+	@mkdir -p $(WS)/src
+	@ln -sfn ../../.. $(WS)/src/cvg_bench
+	@cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) > ../catkin_build.log 2>&1 \
+	  || { tail -n 60 ../catkin_build.log; echo "make build: failed (full log: build/catkin_build.log)"; exit 1; }
+	@echo "make build: ok (tool: bin/cvg_ident)"
+
+demo: build
+	@bash scripts/demo.sh
+
+test: build
+	@bash scripts/run_tests.sh
+
+bench: build
+	@bash scripts/run_benchmarks.sh
+
+format:
+	@clang-format -i $$(git ls-files '*.cpp' '*.h')
+
+clean:
+	rm -rf build

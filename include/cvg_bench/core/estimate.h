@@ -1,0 +1,44 @@
+// The result of an identification: what every estimator (batch LS, RLS, Ceres) returns and what the
+// tool's JSON, the identifier node's messages and the explain report are made from.
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cvg_bench/core/model_term.h"
+
+namespace cvg_bench {
+
+/// One estimated quantity with its standard error and Student-t confidence interval (2.11).
+struct ParameterEstimate {
+  double value = 0.0;
+  double std_error = 0.0;  ///< standard error (same unit as value)
+  double ci_low = 0.0;     ///< value - s_p * std_error
+  double ci_high = 0.0;    ///< value + s_p * std_error
+};
+
+struct Estimate {
+  ExperimentMode mode = ExperimentMode::kFreeDecay;
+  std::string model;   ///< canonical spec, e.g. "linear+xi"
+  std::string method;  ///< "ls", "rls" or "ceres"
+  double omega_rad_s = 0.0;  ///< natural frequency used for tilde quantities [rad/s]
+  int n_equations = 0;       ///< equations actually stacked (NOTES.md item 8)
+  int n_params = 0;
+  int rank = 0;              ///< numerical rank of the regression matrix
+  int dof = 0;               ///< n_equations - rank
+  /// Parameters (or combinations, written as e.g. "gamma+b_c") the data cannot separate.
+  std::vector<std::string> unidentifiable;
+  std::string identifiability_note;  ///< why, in words (empty when full rank)
+  double sigma = 0.0;       ///< sigma-hat (2.10), in equation units (NOTES.md item 14)
+  double confidence = 0.95; ///< P0 of (2.11)
+  std::vector<std::string> names;  ///< parameter names in z order
+  Eigen::VectorXd values;          ///< z-hat
+  Eigen::MatrixXd covariance;      ///< covariance of z-hat (row-major order = names order)
+  std::map<std::string, ParameterEstimate> parameters;  ///< by name
+  std::map<std::string, ParameterEstimate> derived;     ///< section-4 quantities with CIs
+  std::vector<std::string> notes;  ///< provenance: e.g. "demodulated raw f,g at omega = ..."
+};
+
+}  // namespace cvg_bench

@@ -1,0 +1,78 @@
+// One physical effect of the resonator model: the single place where its equation lives.
+//
+// Every term is linear in its own parameters z_term (in the regression units of (2.6)/(3.3)) and
+// supplies two views of the same force:
+//  - fastColumns: its generalized force in the full equations (2.3)/(3.1),
+//        f'' + omega^2 f = F_f,  g'' + omega^2 g = F_g,  (F_f, F_g)^T = fastColumns * z_term;
+//  - averagedColumns: its first-order Krylov-Bogoliubov average in the van der Pol variables (2.4),
+//        2 q' = averagedColumns * z_term,  q = (q1, p1, q2, p2).
+// The averaged view must equal the first-harmonic projection of the fast view,
+//   2 q1' = -(2/omega) <F_f sin(omega t)>,  2 p1' = (2/omega) <F_f cos(omega t)>  (likewise q2, p2 from F_g),
+// which test/core/model_term_averaging_test.cpp checks term by term by quadrature.
+// Tilde quantities (stiffness-type coefficients divided by omega) are stored under the plain name;
+// fastColumns multiplies them back by omega.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace cvg_bench {
+
+/// Experiment mode of the paper: free decay (section 2) or forced oscillation (section 3).
+enum class ExperimentMode { kFreeDecay, kForced };
+
+/// Slow-time context of the averaged model.
+struct SlowContext {
+  /// Time since the start of the record [s] (for time-varying terms such as cm_rate).
+  double t_s = 0.0;
+  /// Known control nonlinearity mu of (3.1)-(3.2) [1/amplitude^2]; 0 for magnetoelectric actuators.
+  double mu = 0.0;
+};
+
+/// State of the full (fast) equations.
+struct FastState {
+  double f = 0.0, f_dot = 0.0, g = 0.0, g_dot = 0.0;
+};
+
+/// Context of the full equations.
+struct FastContext {
+  /// Natural frequency omega [rad/s] (multiplies the tilde parameters back).
+  double omega_rad_s = 1.0;
+  /// Phase of the drive omega0 * t [rad] (controls u1..u4 of (3.1)).
+  double drive_phase_rad = 0.0;
+  /// Time since the start of the record [s] (slowly varying terms).
+  double t_s = 0.0;
+  /// Known control nonlinearity mu.
+  double mu = 0.0;
+};
+
+class ModelTerm {
+ public:
+  virtual ~ModelTerm() = default;
+  /// Canonical name (`linear`, `controls`, `xi`, `kappa`, `gamma_nl`, `cm_rate`, `xi_diff`, ...).
+  virtual std::string name() const = 0;
+  /// Its parameters' canonical names, in column order.
+  virtual std::vector<std::string> parameterNames() const = 0;
+  /// One sentence: what the term is physically.
+  virtual std::string description() const = 0;
+  /// Whether the term exists in the given experiment mode (e.g. controls only when forced).
+  virtual bool appliesTo(ExperimentMode mode) const { return true; }
+  /// 4 x k columns of the averaged regressor D(q) (2.6)/(3.3).
+  virtual void averagedColumns(const Eigen::Vector4d& q, const SlowContext& ctx,
+                               Eigen::Ref<Eigen::MatrixXd> cols) const = 0;
+  /// 2 x k columns of the generalized force in the full equations (2.3)/(3.1).
+  virtual void fastColumns(const FastState& s, const FastContext& ctx,
+                           Eigen::Ref<Eigen::MatrixXd> cols) const = 0;
+  int numParameters() const { return static_cast<int>(parameterNames().size()); }
+};
+
+using ModelTermPtr = std::shared_ptr<const ModelTerm>;
+
+/// The term with this canonical name; throws InputError naming the known terms otherwise.
+ModelTermPtr makeModelTerm(const std::string& name);
+/// Names of all terms makeModelTerm knows, base terms first.
+std::vector<std::string> knownModelTermNames();
+
+}  // namespace cvg_bench

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Runs every test: gtest (core, no roscore), gtest (ROS adapters), rostest integration tests,
+# launch-file checks and Python tests; ends with one line `N passed, N failed`.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+ws="$root/build/ws"
+results="$ws/build/test_results"
+rm -rf "$results" "$root/build/python_test_results"
+mkdir -p "$root/build/python_test_results"
+export PATH=/usr/bin:/bin:$PATH
+# shellcheck disable=SC1091
+source "$ws/devel/setup.bash"
+export ROS_HOME="$root/build/ros_home"
+export ROS_LOG_DIR="$ROS_HOME/log"
+
+(cd "$ws" && catkin_make run_tests -DPYTHON_EXECUTABLE=/usr/bin/python3 -j2 > "$root/build/run_tests.log" 2>&1)
+grep -E "^\[ *(FAILED|  PASSED) *\]|FAILURE|^\[ROSTEST\]|Ran [0-9]+ test" "$root/build/run_tests.log" | tail -n 40
+
+if ls test/python/test_*.py >/dev/null 2>&1; then
+  CVG_BENCH_ROOT="$root" /usr/bin/python3 scripts/run_python_tests.py test/python "$root/build/python_test_results/python.xml"
+fi
+
+/usr/bin/python3 scripts/summarize_test_results.py "$results" "$root/build/python_test_results"

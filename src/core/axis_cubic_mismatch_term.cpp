@@ -1,0 +1,36 @@
+// Unequal cubic stiffness of the two axes (beyond the paper): the f equation has (xi + xi_diff) N f
+// and the g equation (xi - xi_diff) N g. xi_diff is tilde (÷ omega). Averaging as for xi:
+//   2 a' = (i xi_diff / 4)(2 N a + S conj(a)),  2 b' = -(i xi_diff / 4)(2 N b + S conj(b)).
+#include "cvg_bench/core/model_terms.h"
+#include "cvg_bench/core/slow_complex.h"
+
+namespace cvg_bench {
+namespace {
+
+class AxisCubicMismatchTerm : public ModelTerm {
+ public:
+  std::string name() const override { return "xi_diff"; }
+  std::vector<std::string> parameterNames() const override { return {"xi_diff"}; }
+  std::string description() const override {
+    return "unequal cubic stiffness on the two axes (nonlinearity anisotropy)";
+  }
+  void averagedColumns(const Eigen::Vector4d& q, const SlowContext&,
+                       Eigen::Ref<Eigen::MatrixXd> d) const override {
+    const SlowComplex z(q);
+    const std::complex<double> k(0.0, 0.25);
+    setComplexColumn(k * (2.0 * z.n_sq * z.a + z.s * std::conj(z.a)),
+                     -k * (2.0 * z.n_sq * z.b + z.s * std::conj(z.b)), d, 0);
+  }
+  void fastColumns(const FastState& s, const FastContext& c,
+                   Eigen::Ref<Eigen::MatrixXd> cols) const override {
+    const double n = s.f * s.f + s.g * s.g;
+    cols(0, 0) = c.omega_rad_s * n * s.f;
+    cols(1, 0) = -c.omega_rad_s * n * s.g;
+  }
+};
+
+}  // namespace
+
+ModelTermPtr makeAxisCubicMismatchTerm() { return std::make_shared<AxisCubicMismatchTerm>(); }
+
+}  // namespace cvg_bench

@@ -1,0 +1,74 @@
+// cvg_ident drift: the drift rate theta' of (5.9) (corrected, NOTES.md items 4-5) at a given
+// (r, k, theta) or over a theta grid on [0, pi/2), from an identify JSON (or a flat parameter file).
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+
+#include "cli_args.h"
+#include "cvg_bench/core/derived_quantities.h"
+#include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/orbit_elements.h"
+#include "cvg_ident_commands.h"
+#include "estimate_json.h"
+
+namespace cvg_bench {
+namespace tools {
+namespace {
+
+const char* kHelp =
+    "usage: cvg_ident drift --params FILE.json [--r R --k K --theta TH | --theta-grid N]\n"
+    "                       [--angular-gain K] [--json FILE]\n"
+    "Drift rate theta' of (5.9) [rad/s and deg/h] of the wave pattern at amplitude r, quadrature k\n"
+    "(record amplitude units) and pattern angle theta [rad]; default r = 1, k = 0.01, a grid of 8\n"
+    "angles on [0, pi/2). Also prints section 4's derived quantities (angular gain K, default 0.4).\n";
+
+}  // namespace
+
+int runDrift(const std::vector<std::string>& argv) {
+  const CliArgs args(argv, {"params", "r", "k", "theta", "theta-grid", "json", "angular-gain"}, {});
+  if (args.help()) {
+    std::cout << kHelp;
+    return 0;
+  }
+  if (!args.positionals().empty())
+    throw InputError("unexpected argument '" + args.positionals().front() + "'");
+  if (!args.has("params")) throw InputError("--params FILE.json is required");
+  if (args.has("theta") && args.has("theta-grid"))
+    throw InputError("give either --theta or --theta-grid, not both");
+  const ParameterFile pf = readParameterFile(args.get("params"));
+  const double r = args.getDouble("r", 1.0), k = args.getDouble("k", 0.01);
+  const double gain = args.getDouble("angular-gain", 0.4);
+  std::vector<double> thetas;
+  if (args.has("theta")) {
+    thetas.push_back(args.getDouble("theta", 0.0));
+  } else {
+    const long n = args.getInt("theta-grid", 8);
+    if (n < 1 || n > 100000) throw InputError("--theta-grid needs 1..100000 points");
+    for (long i = 0; i < n; ++i) thetas.push_back(M_PI / 2 * i / n);
+  }
+  const DerivedQuantities d = deriveQuantities(pf.values, pf.omega_rad_s, gain);
+  const double to_deg_h = 180.0 / M_PI * 3600.0;
+  nlohmann::json out;
+  out["omega"] = pf.omega_rad_s;
+  out["r"] = r;
+  out["k"] = k;
+  out["derived"] = d.asMap();
+  nlohmann::json rows = nlohmann::json::array();
+  std::cout << std::fixed << std::setprecision(4);
+  std::cout << "derived (section 4, K = " << gain << "):\n";
+  for (const auto& kv : d.asMap()) std::cout << "  " << std::setw(24) << kv.first << "  " << kv.second << "\n";
+  std::cout << "drift rate (5.9) at r = " << r << ", k = " << k << ":\n"
+            << "  theta [rad]   theta [deg]   drift [rad/s]   drift [deg/h]\n";
+  for (double th : thetas) {
+    const double rate = driftRate(r, k, th, pf.values);
+    std::cout << "  " << std::setw(11) << th << "   " << std::setw(11) << th * 180 / M_PI << "   "
+              << std::setw(13) << rate << "   " << std::setw(13) << rate * to_deg_h << "\n";
+    rows.push_back({{"theta_rad", th}, {"drift_rad_s", rate}, {"drift_deg_h", rate * to_deg_h}});
+  }
+  out["drift"] = rows;
+  if (args.has("json")) writeJsonFile(out, args.get("json"));
+  return 0;
+}
+
+}  // namespace tools
+}  // namespace cvg_bench

@@ -1,0 +1,15 @@
+// Placeholder until its issue lands: says so clearly (exit 2).
+#include <iostream>
+
+#include "cvg_ident_commands.h"
+
+namespace cvg_bench {
+namespace tools {
+
+int runIdentify(const std::vector<std::string>&) {
+  std::cerr << "cvg_ident identify: not implemented yet in this build\n";
+  return 2;
+}
+
+}  // namespace tools
+}  // namespace cvg_bench

@@ -1,0 +1,20 @@
+// Subcommands of the offline tool (contract: ../shared/spec/interfaces.md). Each lives in its own
+// cmd_<name>.cpp, takes the arguments after the subcommand name, and returns the exit status
+// (0 success, 1 analysis failed, 2 bad usage or input). Errors may be thrown as InputError (2) or
+// AnalysisError (1); the dispatcher prints them.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace cvg_bench {
+namespace tools {
+
+int runSimulate(const std::vector<std::string>& args);
+int runDemod(const std::vector<std::string>& args);
+int runIdentify(const std::vector<std::string>& args);
+int runDrift(const std::vector<std::string>& args);
+int runExplain(const std::vector<std::string>& args);
+
+}  // namespace tools
+}  // namespace cvg_bench

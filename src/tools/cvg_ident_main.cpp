@@ -1,0 +1,49 @@
+// cvg_ident: the offline tool over the cvg_bench core (no roscore). See interfaces.md.
+#include <iostream>
+#include <map>
+
+#include "cvg_bench/core/errors.h"
+#include "cvg_ident_commands.h"
+
+namespace {
+
+const char* kUsage =
+    "usage: cvg_ident <subcommand> [options]   (every subcommand has --help)\n"
+    "  simulate  --preset NAME|--config FILE --mode free_decay|forced [--raw] [--seed N]\n"
+    "            [--effect NAME=VALUE ...] --out FILE\n"
+    "  demod     INPUT [--omega W] [--rate HZ] [--columns t=COL,f=COL,g=COL] --out FILE\n"
+    "  identify  INPUT --mode free_decay|forced --model TERMS [--method ls|rls|ceres]\n"
+    "            [--confidence P] [--omega W] [--angular-gain K] [--json FILE]\n"
+    "  drift     --params FILE.json [--r R --k K --theta TH | --theta-grid N] [--json FILE]\n"
+    "  explain   INPUT --mode free_decay|forced [--json FILE] [--report DIR]\n"
+    "exit status: 0 success, 1 analysis failed, 2 bad usage or input\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace cvg_bench::tools;
+  const std::map<std::string, int (*)(const std::vector<std::string>&)> commands = {
+      {"simulate", runSimulate}, {"demod", runDemod},     {"identify", runIdentify},
+      {"drift", runDrift},       {"explain", runExplain}};
+  if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
+    std::cout << kUsage;
+    return argc < 2 ? 2 : 0;
+  }
+  const auto it = commands.find(argv[1]);
+  if (it == commands.end()) {
+    std::cerr << "cvg_ident: unknown subcommand '" << argv[1] << "'\n" << kUsage;
+    return 2;
+  }
+  try {
+    return it->second(std::vector<std::string>(argv + 2, argv + argc));
+  } catch (const cvg_bench::InputError& e) {
+    std::cerr << "cvg_ident " << argv[1] << ": error: " << e.what() << "\n";
+    return 2;
+  } catch (const cvg_bench::AnalysisError& e) {
+    std::cerr << "cvg_ident " << argv[1] << ": analysis failed: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "cvg_ident " << argv[1] << ": internal error: " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -1,0 +1,33 @@
+// JSON form of an estimate (interfaces.md "JSON output") and reading it back for `drift`.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "cvg_bench/core/estimate.h"
+#include "cvg_bench/core/resonator_model.h"
+
+namespace cvg_bench {
+namespace tools {
+
+/// The identify JSON of interfaces.md (plus "dof", "method", "covariance", "notes").
+nlohmann::json estimateToJson(const Estimate& e);
+
+/// A parameter file as `drift` reads it: the identify JSON ({"omega", "parameters": {name:
+/// {"value", ...}}, optional "covariance" {"names", "matrix"}}) or a flat {"omega", "parameters":
+/// {name: number}}. Throws InputError naming the file and the problem.
+struct ParameterFile {
+  double omega_rad_s = 0.0;
+  ParameterValues values;
+  std::vector<std::string> cov_names;  ///< empty when the file has no covariance
+  Eigen::MatrixXd covariance;
+  int dof = 0;             ///< degrees of freedom for Student-t (0: normal quantile)
+  double confidence = 0.95;
+};
+ParameterFile readParameterFile(const std::string& path);
+
+/// Writes JSON to path ("-" = stdout), pretty-printed; throws InputError if it cannot be written.
+void writeJsonFile(const nlohmann::json& j, const std::string& path);
+
+}  // namespace tools
+}  // namespace cvg_bench
