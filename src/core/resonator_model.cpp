@@ -68,6 +68,8 @@ ResonatorModel::ResonatorModel(const std::string& spec, ExperimentMode mode) : m
   }
   int offset = 0;
   for (const auto& t : terms_) {
+    if (offset + t->numParameters() > kMaxModelParameters)
+      throw InputError("model '" + spec + "' has too many parameters");
     offsets_.push_back(offset);
     for (const auto& n : t->parameterNames()) names_.push_back(n);
     offset += t->numParameters();
@@ -101,14 +103,14 @@ Eigen::MatrixXd ResonatorModel::regressor(const Eigen::Vector4d& q, const SlowCo
 Eigen::Vector4d ResonatorModel::slowDerivative(const Eigen::Vector4d& q, const SlowContext& ctx,
                                                const Eigen::VectorXd& z,
                                                double detuning_rate) const {
-  Eigen::Matrix<double, 4, Eigen::Dynamic> d(4, numParameters());
+  Eigen::Matrix<double, 4, Eigen::Dynamic, 0, 4, kMaxModelParameters> d(4, numParameters());
   regressor(q, ctx, d);
   return 0.5 * (d * z - detuning_rate * detuningDirection(q));
 }
 
 Eigen::Vector2d ResonatorModel::fastForce(const FastState& s, const FastContext& ctx,
                                           const Eigen::VectorXd& z) const {
-  Eigen::Matrix<double, 2, Eigen::Dynamic> cols(2, numParameters());
+  Eigen::Matrix<double, 2, Eigen::Dynamic, 0, 2, kMaxModelParameters> cols(2, numParameters());
   for (size_t i = 0; i < terms_.size(); ++i) {
     terms_[i]->fastColumns(s, ctx, cols.middleCols(offsets_[i], terms_[i]->numParameters()));
   }

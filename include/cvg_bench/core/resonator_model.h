@@ -33,6 +33,9 @@ Eigen::Vector4d detuningDirection(const Eigen::Vector4d& q);
 ExperimentMode parseExperimentMode(const std::string& name);
 std::string experimentModeName(ExperimentMode mode);
 
+/// Upper bound on the number of parameters of one model (fixed-capacity, allocation-free matrices).
+constexpr int kMaxModelParameters = 32;
+
 class ResonatorModel {
  public:
   /// spec: `linear` or `+`-joined extension names (`xi`, `xi+kappa`, `linear+xi`; the linear base
