@@ -10,7 +10,9 @@ rm -rf "$results" "$root/build/python_test_results"
 mkdir -p "$root/build/python_test_results"
 export PATH=/usr/bin:/bin:$PATH
 # shellcheck disable=SC1091
+set +u
 source "$ws/devel/setup.bash"
+set -u
 export ROS_HOME="$root/build/ros_home"
 export ROS_LOG_DIR="$ROS_HOME/log"
 
