@@ -1,0 +1,44 @@
+"""The core library stays ROS-free: no ROS header in its sources, no catkin library on its link line."""
+import glob
+import os
+import re
+import unittest
+
+ROOT = os.environ.get("CVG_BENCH_ROOT", os.path.join(os.path.dirname(__file__), "..", ".."))
+ROS_INCLUDE = re.compile(r'#\s*include\s*[<"](ros|rosbag|tf2|tf2_ros|diagnostic_updater|std_msgs|'
+                         r'geometry_msgs|cvg_bench/ros|cvg_bench/[A-Z]\w*\.h)')
+
+
+class CoreBoundaries(unittest.TestCase):
+    def test_no_ros_header_in_core_sources(self):
+        files = glob.glob(os.path.join(ROOT, "include", "cvg_bench", "core", "*.h"))
+        files += glob.glob(os.path.join(ROOT, "src", "core", "*.cpp"))
+        self.assertGreater(len(files), 10)
+        offenders = []
+        for path in files:
+            with open(path, encoding="utf-8") as f:
+                for n, line in enumerate(f, 1):
+                    if ROS_INCLUDE.search(line):
+                        offenders.append("%s:%d: %s" % (os.path.relpath(path, ROOT), n, line.strip()))
+        self.assertEqual(offenders, [])
+
+    def test_core_link_line_has_no_catkin_library(self):
+        with open(os.path.join(ROOT, "CMakeLists.txt"), encoding="utf-8") as f:
+            cmake = f.read()
+        links = re.findall(r"target_link_libraries\(\s*cvg_bench_core\b([^)]*)\)", cmake)
+        self.assertTrue(links, "no target_link_libraries for cvg_bench_core")
+        for args in links:
+            self.assertNotIn("catkin", args)
+            self.assertNotIn("ros", args.lower().replace("ceres", ""))
+
+    def test_built_core_library_has_no_ros_symbols(self):
+        lib = glob.glob(os.path.join(ROOT, "build", "ws", "devel", "lib", "libcvg_bench_core.*"))
+        if not lib:
+            self.skipTest("core library not built as a shared library here")
+        import subprocess
+        out = subprocess.run(["nm", "-D", "--undefined-only", lib[0]], capture_output=True, text=True).stdout
+        self.assertNotIn("ros::", subprocess.run(["c++filt"], input=out, capture_output=True, text=True).stdout)
+
+
+if __name__ == "__main__":
+    unittest.main()
