@@ -1,0 +1,48 @@
+// Output-error residuals of a free-decay record (section 2) for Ceres.
+//
+// The model trajectory integrates the averaged equations (2.6), 2 q' = D(q) z, by classical RK4 on
+// the record's own time grid t_0..t_N (optionally with substeps) from the fitted initial slow
+// variables q(t_0):
+//   r_i = q_model(t_i; z, q(t_0)) - q_measured(t_i),  i = 0..N  (4 (N + 1) residuals, units of q).
+// Unlike the equation error of (2.7)-(2.8), the noisy measurement never enters the model, so the
+// residuals are the measurement noise itself (independent), which makes Ceres' covariance honest
+// (NOTES.md items 10, 15). Derivatives: ceres::DynamicNumericDiffCostFunction, central differences.
+#pragma once
+
+#include <ceres/cost_function.h>
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "cvg_bench/core/records.h"
+#include "cvg_bench/core/resonator_model.h"
+
+namespace cvg_bench {
+
+/// q_model at every time of t_s (t_s[0] is the start, SlowContext::t_s counts from it) by RK4 with
+/// `substeps` steps per interval. Returns false (trajectory left unfinished) when it overflows.
+bool integrateSlowTrajectory(const ResonatorModel& model, const Eigen::VectorXd& z,
+                             const Eigen::Vector4d& q0, const std::vector<double>& t_s,
+                             int substeps, std::vector<Eigen::Vector4d>* trajectory);
+
+/// The residual functor: parameter blocks (z [numParameters()], q(t_0) [4]).
+class FreeDecayOutputError {
+ public:
+  /// Keeps references to model and record: both must outlive the functor.
+  FreeDecayOutputError(const ResonatorModel& model, const SlowRecord& record, int substeps);
+  bool operator()(double const* const* parameters, double* residuals) const;
+  int numResiduals() const { return 4 * static_cast<int>(record_.size()); }
+
+ private:
+  const ResonatorModel& model_;
+  const SlowRecord& record_;
+  int substeps_;
+};
+
+/// The Ceres cost function (central numeric differences) over blocks (z, q(t_0)).
+std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(const ResonatorModel& model,
+                                                                  const SlowRecord& record,
+                                                                  int substeps);
+
+}  // namespace cvg_bench
