@@ -1,9 +1,12 @@
 #include "cvg_bench/core/sample_validator.h"
 
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include "cvg_bench/core/errors.h"
+
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace cvg_bench {
 
@@ -48,11 +51,59 @@ void SampleValidator::reset() {
   has_last_ = false;
 }
 
+namespace {
+
+using V4 = double __attribute__((vector_size(32)));
+using M4 = long long __attribute__((vector_size(32)));
+
+inline V4 load4(const double* p) {
+  V4 v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+}
+
+/// Number of samples i >= 1 that are not finite or not one period after sample i - 1, four at a
+/// time and branch-free, so that the clean batches of a running bench cost well under 1 ns each.
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+__attribute__((target_clones("arch=x86-64-v3", "default")))
+#endif
+size_t
+countIrregular(const double* t, const double* f, const double* g, size_t n, double dt, double tol) {
+  M4 bad4 = {0, 0, 0, 0};
+  const V4 dt4 = {dt, dt, dt, dt}, tol4 = {tol, tol, tol, tol}, zero = {0.0, 0.0, 0.0, 0.0};
+  size_t i = 1;
+  for (; i + 4 <= n; i += 4) {
+    const V4 d = load4(t + i) - load4(t + i - 1) - dt4;
+    const V4 fv = load4(f + i), gv = load4(g + i);
+    // x - x == 0 exactly when x is finite; |d - dt| <= tol also fails for a NaN/Inf time.
+    const M4 ok = ((fv - fv) == zero) & ((gv - gv) == zero) & (d <= tol4) & (-d <= tol4);
+    bad4 += ok + 1;  // ok is -1 (true) or 0
+  }
+  size_t bad = static_cast<size_t>(bad4[0] + bad4[1] + bad4[2] + bad4[3]);
+  for (; i < n; ++i) {
+    const double d = t[i] - t[i - 1];
+    bad += !(std::isfinite(f[i]) && std::isfinite(g[i]) && std::fabs(d - dt) <= tol);
+  }
+  return bad;
+}
+
+}  // namespace
+
 std::vector<AcceptedRun> SampleValidator::screen(const double* t, const double* f, const double* g,
                                                  size_t n) {
   std::vector<AcceptedRun> runs;
   if (n == 0) {
     ++counters_.empty_batches;
+    return runs;
+  }
+  // Fast path: the whole batch is finite, on the grid, and starts the stream or continues it.
+  const bool first_ok = std::isfinite(t[0]) && std::isfinite(f[0]) && std::isfinite(g[0]) &&
+                        (!has_last_ || std::fabs(t[0] - last_t_ - dt_) <= tol_);
+  if (first_ok && countIrregular(t, f, g, n, dt_, tol_) == 0) {
+    runs.push_back({0, n, has_last_ ? RunStart::kContinue : RunStart::kRestartFirst, 0, 0.0});
+    counters_.accepted += n;
+    has_last_ = true;
+    last_t_ = t[n - 1];
     return runs;
   }
   if (n >= 8) {
