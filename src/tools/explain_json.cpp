@@ -1,0 +1,71 @@
+#include "explain_json.h"
+
+#include <cmath>
+
+#include "estimate_json.h"
+
+namespace cvg_bench {
+namespace tools {
+namespace {
+
+/// JSON has no infinity: a hold-out ratio of a model whose prediction diverged is written as null.
+nlohmann::json finiteOrNull(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nullptr;
+}
+
+nlohmann::json stepToJson(const SelectionStep& s) {
+  return {{"added", s.added},
+          {"model", s.model},
+          {"sigma", s.sigma},
+          {"sigma_ratio", finiteOrNull(s.sigma_ratio)},
+          {"f_statistic", finiteOrNull(s.wald.f_statistic)},
+          {"df1", s.wald.df1},
+          {"df2", s.wald.df2},
+          {"p_value", s.wald.p_value},
+          {"threshold", s.threshold},
+          {"delta_bic", finiteOrNull(s.delta_bic)},
+          {"holdout_ratio", finiteOrNull(s.holdout_ratio)},
+          {"accepted", s.accepted}};
+}
+
+nlohmann::json signatureToJson(const ResidualSignature& sig) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& e : sig.entries)
+    a.push_back({{"variable", e.variable},
+                 {"component", e.component},
+                 {"correlation", e.correlation},
+                 {"p_value", e.p_value},
+                 {"n_used", e.n_used}});
+  return a;
+}
+
+}  // namespace
+
+nlohmann::json explanationToJson(const Explanation& x) {
+  nlohmann::json j;
+  j["mode"] = experimentModeName(x.mode);
+  j["baseline"] = {{"model", x.selection.baseline.model}, {"sigma", x.selection.baseline.sigma}};
+  nlohmann::json steps = nlohmann::json::array();
+  for (const auto& s : x.selection.steps) steps.push_back(stepToJson(s));
+  j["steps"] = steps;
+  j["selected"] = x.selection.selected;
+  j["dropped"] = x.selection.dropped;
+  j["unexplained"] = x.unexplained;
+  j["lack_of_fit"] = {{"test", x.lack_of_fit.test},
+                      {"p_value", x.lack_of_fit.p_value},
+                      {"worst", x.lack_of_fit.worst}};
+  j["cause"] = x.cause;
+  nlohmann::json rejected = nlohmann::json::array();
+  for (const auto& s : x.selection.last_round) rejected.push_back(stepToJson(s));
+  j["rejected"] = rejected;
+  j["signature"] = signatureToJson(x.baseline_signature);
+  j["signature_summary"] = x.baseline_signature.describe(0.01);
+  j["final_signature"] = signatureToJson(x.final_signature);
+  j["holdout"] = x.selection.holdout_description;
+  j["notes"] = x.notes;
+  j["final"] = estimateToJson(x.finalEstimate());
+  return j;
+}
+
+}  // namespace tools
+}  // namespace cvg_bench

@@ -1,0 +1,17 @@
+// JSON form of an Explanation (interfaces.md "explain"), plus fields beyond the contract:
+// steps[].accepted/df1/df2/threshold, rejected (candidates of the round that stopped the
+// selection), dropped (backward check), signature / final_signature (residual structure),
+// holdout (how the hold-out is made), notes.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "cvg_bench/core/explanation.h"
+
+namespace cvg_bench {
+namespace tools {
+
+nlohmann::json explanationToJson(const Explanation& x);
+
+}  // namespace tools
+}  // namespace cvg_bench
