@@ -1,0 +1,127 @@
+#include "cvg_bench/core/fast_simulator.h"
+
+#include <cmath>
+
+#include "cvg_bench/core/errors.h"
+
+namespace cvg_bench {
+
+Eigen::Vector2d ParametricPumping::force(double f, double g, double drive_phase_rad,
+                                         double omega_rad_s) const {
+  if (!active()) return Eigen::Vector2d::Zero();
+  // (eta/2) u_i u_j = (eta/2) (omega/eta)^2 u~_i u~_j = omega^2 / (2 eta) u~_i u~_j.
+  const double k = omega_rad_s * omega_rad_s / (2.0 * eta);
+  const double c2 = std::cos(2.0 * drive_phase_rad), s2 = std::sin(2.0 * drive_phase_rad);
+  const Eigen::Vector4d& u = u_tilde;
+  return Eigen::Vector2d(-k * ((u[0] * u[0] - u[1] * u[1]) * c2 + 2.0 * u[0] * u[1] * s2) * f,
+                         -k * ((u[2] * u[2] - u[3] * u[3]) * c2 + 2.0 * u[2] * u[3] * s2) * g);
+}
+
+std::vector<std::string> FastSimulatorOptions::validate() const {
+  std::vector<std::string> problems;
+  if (steps_per_period < 4)
+    problems.push_back("steps_per_period must be >= 4, got " + std::to_string(steps_per_period));
+  return problems;
+}
+
+FastSimulator::FastSimulator(const ResonatorModel& model, const Eigen::VectorXd& z,
+                             double omega_rad_s, double reference_rad_s, double mu,
+                             const ParametricPumping& pumping, const FastSimulatorOptions& options)
+    : model_(model), z_(z), omega_(omega_rad_s), w_(reference_rad_s), mu_(mu), pumping_(pumping) {
+  requirePositive(omega_rad_s, "omega");
+  requirePositive(reference_rad_s, "reference frequency W");
+  requireFinite(mu, "mu");
+  requireFinite(pumping.eta, "eta");
+  if (pumping.eta < 0.0) throw InputError("eta must be >= 0 (0 = no parametric terms)");
+  if (!pumping.u_tilde.allFinite()) throw InputError("u~ of the parametric terms must be finite");
+  if (z.size() != model.numParameters())
+    throw InputError("parameter vector has " + std::to_string(z.size()) + " entries, model " +
+                     model.spec() + " needs " + std::to_string(model.numParameters()));
+  if (!z.allFinite()) throw InputError("model parameters must be finite");
+  const auto problems = options.validate();
+  if (!problems.empty()) throw InputError("fast simulator: " + problems.front());
+  max_step_ = 2.0 * M_PI / (w_ * options.steps_per_period);
+}
+
+void FastSimulator::reset(const Eigen::Vector4d& x, double t_s) {
+  if (!x.allFinite()) throw InputError("initial state must be finite");
+  requireFinite(t_s, "initial time");
+  x_ = x;
+  t_ = t_s;
+}
+
+void FastSimulator::resetFast(const FastState& s, double t_s) {
+  // Inverse of (2.4): q1 = f cos - (f'/W) sin, p1 = f sin + (f'/W) cos.
+  const double c = std::cos(w_ * t_s), sn = std::sin(w_ * t_s);
+  reset(Eigen::Vector4d(s.f * c - s.f_dot / w_ * sn, s.f * sn + s.f_dot / w_ * c,
+                        s.g * c - s.g_dot / w_ * sn, s.g * sn + s.g_dot / w_ * c),
+        t_s);
+}
+
+FastState FastSimulator::fastState() const {
+  const double c = std::cos(w_ * t_), s = std::sin(w_ * t_);
+  return FastState{x_[0] * c + x_[1] * s, w_ * (x_[1] * c - x_[0] * s), x_[2] * c + x_[3] * s,
+                   w_ * (x_[3] * c - x_[2] * s)};
+}
+
+Eigen::Vector4d FastSimulator::rhs(double t, const Eigen::Vector4d& x, double c, double s) const {
+  const FastState st{x[0] * c + x[1] * s, w_ * (x[1] * c - x[0] * s), x[2] * c + x[3] * s,
+                     w_ * (x[3] * c - x[2] * s)};
+  const FastContext ctx{omega_, w_ * t, t, mu_};
+  Eigen::Vector2d force = model_.fastForce(st, ctx, z_);
+  if (pumping_.active()) force += pumping_.force(st.f, st.g, w_ * t, omega_);
+  const double detune = w_ * w_ - omega_ * omega_;
+  const double gf = (force[0] + detune * st.f) / w_, gg = (force[1] + detune * st.g) / w_;
+  return Eigen::Vector4d(-gf * s, gf * c, -gg * s, gg * c);
+}
+
+void FastSimulator::step(double h) {
+  const double t0 = t_, tm = t_ + 0.5 * h, t1 = t_ + h;
+  const double c0 = std::cos(w_ * t0), s0 = std::sin(w_ * t0);
+  const double cm = std::cos(w_ * tm), sm = std::sin(w_ * tm);
+  const double c1 = std::cos(w_ * t1), s1 = std::sin(w_ * t1);
+  const Eigen::Vector4d k1 = rhs(t0, x_, c0, s0);
+  const Eigen::Vector4d k2 = rhs(tm, x_ + 0.5 * h * k1, cm, sm);
+  const Eigen::Vector4d k3 = rhs(tm, x_ + 0.5 * h * k2, cm, sm);
+  const Eigen::Vector4d k4 = rhs(t1, x_ + h * k3, c1, s1);
+  x_ += (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  t_ = t1;
+}
+
+void FastSimulator::advanceTo(double t_end_s) {
+  requireFinite(t_end_s, "end time");
+  const double span = t_end_s - t_;
+  if (span < 0.0) throw InputError("fast simulator cannot run backwards in time");
+  if (span == 0.0) return;
+  const long n = std::max(1L, static_cast<long>(std::ceil(span / max_step_ - 1e-9)));
+  const double h = span / n, t0 = t_;
+  for (long k = 0; k < n; ++k) {
+    step(h);
+    t_ = t0 + (k + 1) * h;  // no accumulated rounding in the phase W t
+  }
+  t_ = t_end_s;
+}
+
+void FastSimulator::sampleRaw(double rate_hz, size_t n, RawRecord& out) {
+  requirePositive(rate_hz, "sample rate");
+  const double dt = 1.0 / rate_hz;
+  const long m = std::max(1L, static_cast<long>(std::ceil(dt / max_step_ - 1e-9)));
+  const double h = dt / m, t0 = t_;
+  out.t_s.reserve(out.t_s.size() + n);
+  out.f.reserve(out.f.size() + n);
+  out.g.reserve(out.g.size() + n);
+  for (size_t k = 0; k < n; ++k) {
+    t_ = t0 + k * dt;
+    const FastState s = fastState();
+    out.t_s.push_back(t_);
+    out.f.push_back(s.f);
+    out.g.push_back(s.g);
+    for (long j = 0; j < m; ++j) {
+      step(h);
+      t_ = t0 + k * dt + (j + 1) * h;
+    }
+  }
+  t_ = t0 + n * dt;
+}
+
+}  // namespace cvg_bench
