@@ -14,8 +14,6 @@ std::vector<std::string> ExplainOptions::validate() const {
   for (const auto& s : selection.validate()) p.push_back(s);
   if (!(lack_of_fit_alpha > 0.0 && lack_of_fit_alpha < 0.5))
     p.push_back("lack_of_fit_alpha must lie in (0, 0.5)");
-  if (lack_of_fit_windows < 10 || lack_of_fit_windows > 1000)
-    p.push_back("lack_of_fit_windows must lie in 10..1000");
   if (signature_stride < 3) p.push_back("signature_stride must be >= 3 (NOTES.md item 10)");
   if (signature_bins < 2 || signature_bins > 100) p.push_back("signature_bins must lie in 2..100");
   return p;
@@ -74,8 +72,7 @@ std::vector<std::pair<std::string, std::vector<double>>> sequences(
   return s;
 }
 
-LackOfFit lackOfFit(ExperimentMode mode, std::vector<BlockResidual> blocks,
-                    const ExplainOptions& options) {
+LackOfFit lackOfFit(ExperimentMode mode, std::vector<BlockResidual> blocks) {
   if (mode == ExperimentMode::kForced) {
     std::stable_sort(
         blocks.begin(), blocks.end(),
@@ -85,15 +82,18 @@ LackOfFit lackOfFit(ExperimentMode mode, std::vector<BlockResidual> blocks,
         "(radial, tangential and the 4 components; Bonferroni over 6)",
         sequences(blocks, 1));
   }
-  const int windows = std::min<int>(options.lack_of_fit_windows,
-                                    std::max<int>(1, static_cast<int>(blocks.size()) / 3));
-  const int window = std::max<int>(3, static_cast<int>(blocks.size()) / std::max(1, windows));
-  return combinedRuns("Wald-Wolfowitz runs test of equation-residual sums over " +
-                          std::to_string(blocks.size() / window) + " disjoint windows of " +
-                          std::to_string(window) +
-                          " blocks (telescoping sums, NOTES.md item 10; radial, tangential and "
-                          "the 4 components; Bonferroni over 6)",
-                      sequences(blocks, window));
+  // Trajectory residuals, decimated to at most ~200 values per sequence (demodulated records
+  // carry noise correlated over the filter length).
+  const size_t stride = std::max<size_t>(1, (blocks.size() + 199) / 200);
+  std::vector<BlockResidual> used;
+  for (size_t i = 0; i < blocks.size(); i += stride) used.push_back(blocks[i]);
+  return combinedRuns(
+      "Wald-Wolfowitz runs test of the output-error (trajectory) residuals "
+      "q_measured - q_model, every " +
+          std::to_string(stride) +
+          " sample(s) (radial, tangential and the 4 components; Bonferroni "
+          "over 6)",
+      sequences(used, 1));
 }
 
 std::string describeStep(const SelectionStep& s, const CandidateExtension& c, const Estimate& fin,
@@ -168,7 +168,7 @@ Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
   x.final_blocks = fitter.blocks(x.selection.final_fit);
   x.baseline_signature = residualSignature(x.baseline_blocks, mode, stride, options.signature_bins);
   x.final_signature = residualSignature(x.final_blocks, mode, stride, options.signature_bins);
-  x.lack_of_fit = lackOfFit(mode, x.final_blocks, options);
+  x.lack_of_fit = lackOfFit(mode, fitter.adequacyResiduals(x.selection.final_fit));
   const ResidualSignature& fs = x.final_signature;
   bool structured = false;
   for (const auto& e : fs.entries)

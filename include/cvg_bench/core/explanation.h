@@ -8,12 +8,11 @@
 //   forced sweep: Wald-Wolfowitz runs test of the per-point residuals ordered by drive frequency
 //     (points do not share samples, so they are independent under an adequate model), on the
 //     radial and tangential projections and the 4 components, Bonferroni over the 6 sequences;
-//   free decay: the same runs test on sums of the equation residuals over disjoint windows of
-//     consecutive blocks (NOTES.md item 10: single blocks share samples, so a whiteness test on
-//     them flags clean data; a window sum of y_i = 2(q_{i+1} - q_{i-1}) telescopes, leaving only
-//     the end samples' noise, while a missing term's contribution accumulates; adjacent window sums
-//     share end samples with opposite signs, i.e. are negatively correlated, which makes the
-//     too-few-runs test conservative);
+//   free decay: the same runs test on the output-error (trajectory) residuals q_measured - q_model
+//     (z of the output-error fit, initial state refitted): NOTES.md item 10, the equation errors
+//     of (2.8) share samples, so a whiteness test on them flags clean data; the trajectory
+//     residuals are the measurement noise itself under an adequate model. Decimated to ~200
+//     values per sequence;
 // (4) the verdict in words: cause, parameter with CI, gain; `unexplained` when the final model
 // still fails the lack-of-fit test or keeps a significant residual signature.
 // The ROS identifier node's Explain service and the tool's `explain` subcommand both call
@@ -39,8 +38,6 @@ struct ExplainOptions {
   std::vector<std::string> candidates;
   /// Level of the lack-of-fit test and of the residual signature (Bonferroni inside), in (0, 0.5).
   double lack_of_fit_alpha = 0.01;
-  /// Free decay: number of disjoint windows of the lack-of-fit runs test, 10..1000.
-  int lack_of_fit_windows = 40;
   /// Free decay: every stride-th block is used by the signature correlations, >= 3 (item 10).
   int signature_stride = 3;
   /// Bins of the signature plots, 2..100.

@@ -53,6 +53,10 @@ class NestedModelFitter {
   virtual std::string holdoutDescription() const = 0;
   /// The fit's equation residuals per block with the slow state and abscissa of each block.
   virtual std::vector<BlockResidual> blocks(const NestedFit& fit) const = 0;
+  /// Residuals for the adequacy (lack-of-fit) test, independent under an adequate model: free
+  /// decay the output-error trajectory residuals q_measured - q_model per sample (initial state
+  /// refitted), forced the per-point equation residuals (= blocks()).
+  virtual std::vector<BlockResidual> adequacyResiduals(const NestedFit& fit) const = 0;
 };
 
 struct SelectionOptions {
