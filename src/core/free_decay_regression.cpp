@@ -73,15 +73,24 @@ void forEachFreeDecayBlock(const ResonatorModel& model, const SlowRecord& record
     model.regressor(record.q[i + 1], ctx, next);
     if (simpson) {
       const double h = 0.5 * (record.t_s[i + 1] - record.t_s[i - 1]);
-      dbar = (h / 3.0) * (prev + 4.0 * mid + next);
+      b.weights[0] = b.weights[2] = h / 3.0;
+      b.weights[1] = 4.0 * h / 3.0;
     } else {
       const double h0 = record.t_s[i] - record.t_s[i - 1], h1 = record.t_s[i + 1] - record.t_s[i];
-      dbar = (0.5 * h0) * prev + (0.5 * (h0 + h1)) * mid + (0.5 * h1) * next;
+      b.weights[0] = 0.5 * h0;
+      b.weights[1] = 0.5 * (h0 + h1);
+      b.weights[2] = 0.5 * h1;
     }
+    dbar = b.weights[0] * prev + b.weights[1] * mid + b.weights[2] * next;
     b.y = 2.0 * (record.q[i + 1] - record.q[i - 1]);
     b.q = record.q[i];
     b.abscissa = record.t_s[i] - t0;
     b.index = static_cast<long>(i) - 1;
+    b.q_prev = record.q[i - 1];
+    b.q_next = record.q[i + 1];
+    b.t_prev = record.t_s[i - 1] - t0;
+    b.t_next = record.t_s[i + 1] - t0;
+    b.last_in_record = i + 2 == n;
     visit(b);
   }
 }

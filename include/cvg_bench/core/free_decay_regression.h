@@ -20,6 +20,12 @@ struct RegressionBlock {
   Eigen::Vector4d q;                         ///< the centre sample q_i / the sweep point q_j
   double abscissa = 0.0;  ///< centre time t_i - t_0 [s] (free decay) or omega0_j [rad/s] (forced)
   long index = 0;         ///< block index within its record (free decay: i - 1; forced: j)
+  /// Free decay only: the neighbouring samples q_{i-1}, q_{i+1}, their times since the record's
+  /// first sample, and the quadrature weights of D(q_{i-1}), D(q_i), D(q_{i+1}) in D-bar_i.
+  Eigen::Vector4d q_prev = Eigen::Vector4d::Zero(), q_next = Eigen::Vector4d::Zero();
+  double t_prev = 0.0, t_next = 0.0;
+  double weights[3] = {0.0, 0.0, 0.0};
+  bool last_in_record = false;  ///< free decay: this is block N-1 of its record
 };
 
 using RegressionVisitor = std::function<void(const RegressionBlock&)>;

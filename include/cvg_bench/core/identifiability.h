@@ -27,21 +27,27 @@ struct IdentifiabilityReport {
   std::string note;
 };
 
-/// Facts about the data used to explain a rank deficiency.
+/// Facts about the data used to explain a rank deficiency (accumulated sample by sample).
 struct ExcitationSummary {
-  double max_amplitude = 0.0;     ///< max |q|
-  double max_mode1 = 0.0;         ///< max sqrt(q1^2 + p1^2)
-  double max_mode2 = 0.0;         ///< max sqrt(q2^2 + p2^2)
-  double amplitude_spread = 0.0;  ///< (max |q| - min |q|) / max |q|
-  int num_points = 0;             ///< samples / sweep points
+  double max_amplitude = 0.0;  ///< max |q|
+  double min_amplitude = 0.0;  ///< min |q|
+  double max_mode1 = 0.0;      ///< max sqrt(q1^2 + p1^2)
+  double max_mode2 = 0.0;      ///< max sqrt(q2^2 + p2^2)
+  long num_points = 0;         ///< samples / sweep points
+  void add(const Eigen::Vector4d& q);
+  /// (max |q| - min |q|) / max |q| (0 without data).
+  double amplitudeSpread() const;
 };
+/// The summary of a whole record's samples.
 ExcitationSummary summarizeExcitation(const std::vector<Eigen::Vector4d>& q);
 
-/// names: parameter names (z order); null_space: k x (k - rank), parameter units (from
-/// LeastSquaresSolution). Entries below coefficient_tolerance (relative to the largest entry of a
-/// null vector) count as 0.
+/// names: parameter names (z order); null_space: k x (k - rank), parameter units, and
+/// column_norms: the regression matrix's column norms (both from LeastSquaresSolution). The
+/// analysis runs in column-equilibrated units; null-space entries below coefficient_tolerance
+/// count as 0.
 IdentifiabilityReport analyzeIdentifiability(const std::vector<std::string>& names,
                                              const Eigen::MatrixXd& null_space,
+                                             const Eigen::VectorXd& column_norms,
                                              const ExcitationSummary& excitation,
                                              double coefficient_tolerance = 1e-6);
 
