@@ -150,8 +150,9 @@ RunsTestResult runsTest(const std::vector<double>& values) {
     if (std::isfinite(v)) finite.push_back(v);
   if (finite.size() < 2) return r;
   std::vector<double> sorted = finite;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double median = sorted[sorted.size() / 2];
+  std::sort(sorted.begin(), sorted.end());
+  const size_t h = sorted.size() / 2;
+  const double median = sorted.size() % 2 ? sorted[h] : 0.5 * (sorted[h - 1] + sorted[h]);
   int n_pos = 0, n_neg = 0, prev = 0;
   for (double v : finite) {
     if (v == median) continue;
