@@ -79,6 +79,8 @@ double startMu(const Estimate& start, const CeresOptions& options) {
 
 /// What the estimate is built from once Ceres has finished.
 struct FittedProblem {
+  /// The problem whose Jacobian gives rank and covariance (may differ from the solved one only in
+  /// how derivatives are taken).
   ceres::Problem* problem = nullptr;
   std::vector<double*> blocks;  ///< parameter blocks, reported ones first
   std::vector<int> block_sizes;
@@ -294,8 +296,15 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
   e.notes.push_back(kSigmaNote);
   e.notes.push_back(solverNote(summary));
 
+  // The final Jacobian by Ridders' extrapolation: central differences are good to ~1e-10, too
+  // coarse for a clean rank decision and null space.
+  ceres::Problem final_problem;
+  final_problem.AddResidualBlock(
+      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps, NumericDerivative::kRidders)
+          .release(),
+      nullptr, z.data(), q0.data());
   FittedProblem fp;
-  fp.problem = &problem;
+  fp.problem = &final_problem;
   fp.blocks = {z.data(), q0.data()};
   fp.block_sizes = {k, 4};
   fp.all_names = model.parameterNames();

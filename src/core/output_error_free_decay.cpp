@@ -47,18 +47,31 @@ bool FreeDecayOutputError::operator()(double const* const* parameters, double* r
   return true;
 }
 
-std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(const ResonatorModel& model,
-                                                                  const SlowRecord& record,
-                                                                  int substeps) {
+namespace {
+
+template <ceres::NumericDiffMethodType kMethod>
+std::unique_ptr<ceres::CostFunction> makeCost(const ResonatorModel& model, const SlowRecord& record,
+                                              int substeps) {
   auto* functor = new FreeDecayOutputError(model, record, substeps);
   const int n_residuals = functor->numResiduals();
   auto cost =
-      std::make_unique<ceres::DynamicNumericDiffCostFunction<FreeDecayOutputError, ceres::CENTRAL>>(
+      std::make_unique<ceres::DynamicNumericDiffCostFunction<FreeDecayOutputError, kMethod>>(
           functor);
   cost->AddParameterBlock(model.numParameters());
   cost->AddParameterBlock(4);
   cost->SetNumResiduals(n_residuals);
   return cost;
+}
+
+}  // namespace
+
+std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(const ResonatorModel& model,
+                                                                  const SlowRecord& record,
+                                                                  int substeps,
+                                                                  NumericDerivative derivative) {
+  if (derivative == NumericDerivative::kRidders)
+    return makeCost<ceres::RIDDERS>(model, record, substeps);
+  return makeCost<ceres::CENTRAL>(model, record, substeps);
 }
 
 }  // namespace cvg_bench

@@ -49,7 +49,8 @@ struct CeresOptions {
   StationarySolverOptions stationary;
   /// Singular values of the column-normalised Jacobian below this fraction of the largest count as
   /// zero (rank deficiency; the parameters involved are reported as unidentifiable), in (0, 1).
-  double rank_tolerance = 1e-9;
+  /// (sqrt of the default min_reciprocal_condition_number, which applies to J'J.)
+  double rank_tolerance = 1e-7;
   /// ceres::Covariance min_reciprocal_condition_number (DENSE_SVD truncation), in (0, 1).
   double min_reciprocal_condition_number = 1e-14;
   /// Fill Estimate::derived (section 4 quantities with delta-method CIs) when omega is known and

@@ -6,7 +6,8 @@
 //   r_i = q_model(t_i; z, q(t_0)) - q_measured(t_i),  i = 0..N  (4 (N + 1) residuals, units of q).
 // Unlike the equation error of (2.7)-(2.8), the noisy measurement never enters the model, so the
 // residuals are the measurement noise itself (independent), which makes Ceres' covariance honest
-// (NOTES.md items 10, 15). Derivatives: ceres::DynamicNumericDiffCostFunction, central differences.
+// (NOTES.md items 10, 15). Derivatives: ceres::DynamicNumericDiffCostFunction, central differences
+// while iterating, Ridders' extrapolation for the final Jacobian (covariance, rank).
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -40,9 +41,16 @@ class FreeDecayOutputError {
   int substeps_;
 };
 
-/// The Ceres cost function (central numeric differences) over blocks (z, q(t_0)).
-std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(const ResonatorModel& model,
-                                                                  const SlowRecord& record,
-                                                                  int substeps);
+/// How the Jacobian of the trajectory residuals is differenced.
+enum class NumericDerivative {
+  kCentral,  ///< central differences (2 trajectories per unknown, ~1e-10 relative accuracy)
+  kRidders,  ///< Ridders' extrapolation (several times dearer, ~1e-13): the final Jacobian of the
+             ///< covariance and the rank decision
+};
+
+/// The Ceres cost function over blocks (z, q(t_0)).
+std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(
+    const ResonatorModel& model, const SlowRecord& record, int substeps,
+    NumericDerivative derivative = NumericDerivative::kCentral);
 
 }  // namespace cvg_bench
