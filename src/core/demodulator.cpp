@@ -348,6 +348,7 @@ SlowRecord demodulateUniform(const RawRecord& raw, DemodulatorOptions options,
   rec.source = raw.source;
   rec.metadata["mode"] = "free_decay";
   std::ostringstream d;
+  d.precision(12);
   d << "uniform FIR, reference " << options.omega_rad_s << " rad/s, input "
     << options.sample_rate_hz << " Hz, output " << demod.outputRateHz() << " Hz, passband "
     << demod.passbandHz() << " Hz, stopband " << demod.stopbandHz() << " Hz at "

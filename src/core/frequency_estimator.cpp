@@ -211,6 +211,7 @@ FrequencyEstimate estimateFrequency(const std::vector<double>& t, const std::vec
   est.amplitude = std::sqrt(fit.theta[1] * fit.theta[1] + fit.theta[2] * fit.theta[2] +
                             fit.theta[4] * fit.theta[4] + fit.theta[5] * fit.theta[5]);
   std::ostringstream m;
+  m.precision(12);
   m << "estimated from the data: FFT peak of f,g (" << nfft << " points, " << seg_n
     << " samples) at " << est.coarse_rad_s << " rad/s, refined by nonlinear least squares of "
     << "common-frequency sinusoids in " << stages << " stage(s) to " << est.omega_rad_s << " +- "

@@ -126,6 +126,7 @@ IrregularDemodResult demodulateIrregular(const RawRecord& raw,
   res.record.source = raw.source;
   res.record.metadata["mode"] = "free_decay";
   std::ostringstream d;
+  d.precision(12);
   d << "windowed least squares, reference " << o.omega_rad_s << " rad/s, window " << window
     << " s, output " << o.output_rate_hz << " Hz, " << res.n_too_few + res.n_rank_deficient
     << " windows skipped";
