@@ -1,11 +1,13 @@
 // cvg_ident drift: the drift rate theta' of (5.9) (corrected, NOTES.md items 4-5) at a given
-// (r, k, theta) or over a theta grid on [0, pi/2), from an identify JSON (or a flat parameter file).
+// (r, k, theta) or over a theta grid on [0, pi/2), from an identify JSON (or a flat parameter
+// file).
 #include <cmath>
 #include <iomanip>
 #include <iostream>
 
 #include "cli_args.h"
 #include "cvg_bench/core/derived_quantities.h"
+#include "cvg_bench/core/derived_uncertainty.h"
 #include "cvg_bench/core/errors.h"
 #include "cvg_bench/core/orbit_elements.h"
 #include "cvg_ident_commands.h"
@@ -18,9 +20,13 @@ namespace {
 const char* kHelp =
     "usage: cvg_ident drift --params FILE.json [--r R --k K --theta TH | --theta-grid N]\n"
     "                       [--angular-gain K] [--json FILE]\n"
-    "Drift rate theta' of (5.9) [rad/s and deg/h] of the wave pattern at amplitude r, quadrature k\n"
+    "Drift rate theta' of (5.9) [rad/s and deg/h] of the wave pattern at amplitude r, quadrature "
+    "k\n"
     "(record amplitude units) and pattern angle theta [rad]; default r = 1, k = 0.01, a grid of 8\n"
-    "angles on [0, pi/2). Also prints section 4's derived quantities (angular gain K, default 0.4).\n";
+    "angles on [0, pi/2). Also prints section 4's derived quantities (angular gain K, default "
+    "0.4).\n"
+    "When the params file carries a covariance (identify --json), every figure gets a confidence\n"
+    "interval by the delta method (numerical Jacobian; the file's confidence and interval_dof).\n";
 
 }  // namespace
 
@@ -46,24 +52,59 @@ int runDrift(const std::vector<std::string>& argv) {
     if (n < 1 || n > 100000) throw InputError("--theta-grid needs 1..100000 points");
     for (long i = 0; i < n; ++i) thetas.push_back(M_PI / 2 * i / n);
   }
-  const DerivedQuantities d = deriveQuantities(pf.values, pf.omega_rad_s, gain);
+  UncertainParameters up;
+  up.values = pf.values;
+  up.cov_names = pf.cov_names;
+  up.covariance = pf.covariance;
+  up.dof = pf.dof;
+  up.confidence = pf.confidence;
+  const bool with_ci = !pf.cov_names.empty();
+  const auto derived = deriveQuantitiesWithIntervals(up, pf.omega_rad_s, gain);
   const double to_deg_h = 180.0 / M_PI * 3600.0;
   nlohmann::json out;
   out["omega"] = pf.omega_rad_s;
   out["r"] = r;
   out["k"] = k;
-  out["derived"] = d.asMap();
+  nlohmann::json dj = nlohmann::json::object(), dci = nlohmann::json::object();
+  for (const auto& kv : derived) {
+    dj[kv.first] = kv.second.value;
+    dci[kv.first] = {{"value", kv.second.value},
+                     {"std", kv.second.std_error},
+                     {"ci_low", kv.second.ci_low},
+                     {"ci_high", kv.second.ci_high}};
+  }
+  out["derived"] = dj;
+  if (with_ci) {
+    out["derived_ci"] = dci;
+    out["confidence"] = pf.confidence;
+  }
   nlohmann::json rows = nlohmann::json::array();
   std::cout << std::fixed << std::setprecision(4);
-  std::cout << "derived (section 4, K = " << gain << "):\n";
-  for (const auto& kv : d.asMap()) std::cout << "  " << std::setw(24) << kv.first << "  " << kv.second << "\n";
+  std::cout << "derived (section 4, K = " << gain << ")"
+            << (with_ci ? ", +- half-width of the " + std::to_string(pf.confidence) + " CI" : "")
+            << ":\n";
+  for (const auto& kv : derived) {
+    std::cout << "  " << std::setw(24) << kv.first << "  " << kv.second.value;
+    if (with_ci) std::cout << "  +- " << kv.second.ci_high - kv.second.value;
+    std::cout << "\n";
+  }
   std::cout << "drift rate (5.9) at r = " << r << ", k = " << k << ":\n"
-            << "  theta [rad]   theta [deg]   drift [rad/s]   drift [deg/h]\n";
+            << "  theta [rad]   theta [deg]   drift [rad/s]   drift [deg/h]"
+            << (with_ci ? "   +- CI [deg/h]" : "") << "\n";
   for (double th : thetas) {
-    const double rate = driftRate(r, k, th, pf.values);
+    const ParameterEstimate rate = driftRateWithInterval(r, k, th, up);
     std::cout << "  " << std::setw(11) << th << "   " << std::setw(11) << th * 180 / M_PI << "   "
-              << std::setw(13) << rate << "   " << std::setw(13) << rate * to_deg_h << "\n";
-    rows.push_back({{"theta_rad", th}, {"drift_rad_s", rate}, {"drift_deg_h", rate * to_deg_h}});
+              << std::setw(13) << rate.value << "   " << std::setw(13) << rate.value * to_deg_h;
+    if (with_ci) std::cout << "   " << std::setw(13) << (rate.ci_high - rate.value) * to_deg_h;
+    std::cout << "\n";
+    nlohmann::json row = {
+        {"theta_rad", th}, {"drift_rad_s", rate.value}, {"drift_deg_h", rate.value * to_deg_h}};
+    if (with_ci) {
+      row["std_rad_s"] = rate.std_error;
+      row["ci_low_rad_s"] = rate.ci_low;
+      row["ci_high_rad_s"] = rate.ci_high;
+    }
+    rows.push_back(row);
   }
   out["drift"] = rows;
   if (args.has("json")) writeJsonFile(out, args.get("json"));

@@ -53,6 +53,19 @@ nlohmann::json estimateToJson(const Estimate& e) {
     }
     j["covariance"] = {{"names", e.names}, {"matrix", rows}};
   }
+  if (!e.parameters_paper.empty()) {
+    nlohmann::json paper = nlohmann::json::object();
+    for (const auto& kv : e.parameters_paper) paper[kv.first] = parameterToJson(kv.second);
+    j["parameters_paper_2_11"] = paper;
+  }
+  if (!e.interval_method.empty()) j["interval_method"] = e.interval_method;
+  j["interval_dof"] = e.interval_dof;
+  if (!e.combinations.empty()) {
+    nlohmann::json comb = nlohmann::json::object();
+    for (const auto& kv : e.combinations) comb[kv.first] = parameterToJson(kv.second);
+    j["identifiable_combinations"] = comb;
+  }
+  if (!e.singular_values.empty()) j["singular_values"] = e.singular_values;
   j["notes"] = e.notes;
   return j;
 }
@@ -81,12 +94,16 @@ ParameterFile readParameterFile(const std::string& path) {
                kv.value()["value"].is_number()) {
       v = kv.value()["value"].get<double>();
     } else {
-      throw InputError(path + ": parameter '" + kv.key() + "' needs a number or {\"value\": number}");
+      throw InputError(path + ": parameter '" + kv.key() +
+                       "' needs a number or {\"value\": number}");
     }
     requireFinite(v, path + ": parameter " + kv.key());
     f.values[kv.key()] = v;
   }
   if (j.contains("dof") && j["dof"].is_number_integer()) f.dof = j["dof"].get<int>();
+  // The intervals of "parameters" use interval_dof (the honest covariance's quantile).
+  if (j.contains("interval_dof") && j["interval_dof"].is_number_integer())
+    f.dof = j["interval_dof"].get<int>();
   if (j.contains("confidence") && j["confidence"].is_number())
     f.confidence = j["confidence"].get<double>();
   if (j.contains("covariance") && j["covariance"].is_object()) {
