@@ -77,13 +77,20 @@ class FastSimulator {
  private:
   Eigen::Vector4d rhs(double t, const Eigen::Vector4d& x, double c, double s) const;
 
+  /// (F_f, F_g) of the model's terms (the same sum as ResonatorModel::fastForce, with the terms'
+  /// column counts cached so that a step allocates nothing).
+  Eigen::Vector2d modelForce(const FastState& s, const FastContext& ctx) const;
+
   ResonatorModel model_;
   Eigen::VectorXd z_;
+  std::vector<int> term_columns_;  ///< parameters per term, in model_.terms() order
   double omega_, w_, mu_;
   ParametricPumping pumping_;
   double max_step_;
   Eigen::Vector4d x_ = Eigen::Vector4d::Zero();
   double t_ = 0.0;
+  /// cos, sin of W h / 2 for the last step length h (cached: steps mostly have one length).
+  double half_step_of_ = -1.0, half_cos_ = 1.0, half_sin_ = 0.0;
 };
 
 }  // namespace cvg_bench
