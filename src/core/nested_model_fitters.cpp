@@ -42,6 +42,18 @@ NestedFit fitSystem(const StackedSystem& sys, const IdentificationOptions& o,
   return f;
 }
 
+/// identifyForced (per-point cluster sandwich intervals) plus the equation residuals.
+NestedFit fitRecord(const SweepRecord& record, const IdentificationOptions& o,
+                    const std::vector<std::string>& extensions) {
+  const StackedSystem sys = buildForcedSystem({record}, o);
+  NestedFit f = fitSystem(sys, o, extensions);
+  f.estimate = identifyForced(record, o);
+  f.residuals = equationResiduals(sys, f.estimate.values);
+  f.rss = f.residuals.squaredNorm();
+  f.sigma = f.estimate.sigma;
+  return f;
+}
+
 void throwIfInvalid(const NestedFitterOptions& options) {
   const auto problems = options.validate();
   if (problems.empty()) return;
@@ -151,10 +163,22 @@ class FreeDecayFitter : public NestedModelFitter {
     o.model = modelSpecOf(extensions);
     const StackedSystem sys = buildFreeDecaySystem({record}, o);
     NestedFit f = fitSystem(sys, o, extensions);
+    f.estimate = identifyFreeDecay(record, o);  // honest lag-2 sandwich intervals
+    f.residuals = equationResiduals(sys, f.estimate.values);
+    f.rss = f.residuals.squaredNorm();
+    f.sigma = f.estimate.sigma;
     CeresOptions c = options_.ceres;
     c.confidence = o.confidence;
     c.rk4_substeps = options_.rk4_substeps;
-    f.estimate = refineWithCeres(record, f.estimate, c);
+    try {
+      f.estimate = refineWithCeres(record, f.estimate, c);
+    } catch (const AnalysisError& err) {
+      // Keep the LS answer (honest sandwich intervals) and say why.
+      f.estimate.notes.push_back(std::string("output-error refinement failed, equation-error LS "
+                                             "kept (its xi-type terms carry an EIV bias): ") +
+                                 err.what());
+      return f;
+    }
     f.residuals = equationResiduals(sys, f.estimate.values);
     f.sigma = f.estimate.sigma;
     f.n_equations = f.estimate.n_equations;
@@ -246,7 +270,7 @@ class ForcedFitter : public NestedModelFitter {
     IdentificationOptions o = options_.identification;
     o.omega_rad_s = omega_;
     o.model = modelSpecOf(withoutMu(extensions));
-    NestedFit f = fitSystem(buildForcedSystem({record}, o), o, extensions);
+    NestedFit f = fitRecord(record, o, extensions);
     if (!hasMu(extensions)) return f;
     // mu multiplies u~ bilinearly (3.2): estimate it by output error, then refit z by LS at that
     // mu so that sigma and the residuals stay in equation units.
@@ -256,7 +280,7 @@ class ForcedFitter : public NestedModelFitter {
     c.confidence = o.confidence;
     const Estimate ceres = refineWithCeres(record, start, c);
     o.mu = ceres.parameters.at("mu").value;
-    NestedFit refit = fitSystem(buildForcedSystem({record}, o), o, extensions);
+    NestedFit refit = fitRecord(record, o, extensions);
     refit.estimate = ceres;
     refit.model = modelSpecOf(extensions);
     return refit;

@@ -1,5 +1,6 @@
 // cvg_ident explain: what the linear model gets wrong, the physical cause, the extended model and
 // the gain (core: explanation.h). Raw t,f,g input is demodulated first (and the output says so).
+#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -8,6 +9,8 @@
 #include "cvg_bench/core/demodulator.h"
 #include "cvg_bench/core/errors.h"
 #include "cvg_bench/core/explanation.h"
+#include "cvg_bench/core/frequency_estimator.h"
+#include "cvg_bench/core/irregular_demodulator.h"
 #include "cvg_bench/core/record_io.h"
 #include "cvg_ident_commands.h"
 #include "estimate_json.h"
@@ -45,15 +48,38 @@ std::vector<std::string> splitList(const std::string& s) {
   return out;
 }
 
+/// Raw t,f,g -> slow q: reference frequency from --omega / the file, else estimated; uniform
+/// timestamps by the FIR demodulator, irregular ones by windowed least squares (2 periods per
+/// window, one output per period).
 SlowRecord demodulateRaw(const RawRecord& raw, double omega, std::vector<std::string>* notes) {
-  if (!(omega > 0.0))
-    throw InputError(raw.source + ": raw record without a natural frequency: give --omega W");
-  DemodulatorOptions d;
-  d.omega_rad_s = omega;
-  SlowRecord slow = demodulateUniform(raw, d);
   std::ostringstream s;
-  s << "input " << raw.source << " is a raw t,f,g record: demodulated at W = " << omega
-    << " rad/s (uniform FIR path) into " << slow.size() << " slow samples";
+  s << std::setprecision(8) << "input " << raw.source << " is a raw t,f,g record";
+  if (raw.n_reordered > 0 || raw.n_duplicates_dropped > 0)
+    s << " (" << raw.n_reordered << " rows reordered, " << raw.n_duplicates_dropped
+      << " duplicated timestamps dropped)";
+  if (!(omega > 0.0)) {
+    const FrequencyEstimate fe = estimateFrequency(raw.t_s, raw.f, raw.g);
+    omega = fe.omega_rad_s;
+    s << "; reference frequency estimated: W = " << omega << " +/- " << fe.std_rad_s << " rad/s ("
+      << fe.method << ")";
+  }
+  SlowRecord slow;
+  if (summarizeSampling(raw.t_s).uniform) {
+    DemodulatorOptions d;
+    d.omega_rad_s = omega;
+    slow = demodulateUniform(raw, d);
+    s << "; demodulated at W = " << omega << " rad/s (uniform FIR path)";
+  } else {
+    IrregularDemodulatorOptions d;
+    d.omega_rad_s = omega;
+    d.output_rate_hz = omega / (2.0 * M_PI);
+    slow = demodulateIrregular(raw, d).record;
+    s << "; demodulated at W = " << omega
+      << " rad/s by windowed least squares (irregular timestamps; window 2 periods, one output "
+         "per period)";
+  }
+  slow.omega_rad_s = omega;
+  s << " into " << slow.size() << " slow samples";
   notes->push_back(s.str());
   return slow;
 }
@@ -120,6 +146,7 @@ int runExplain(const std::vector<std::string>& argv) {
       throw InputError(input + ": a forced sweep (omega0,q1,...) given with --mode free_decay");
     const double omega = id.omega_rad_s > 0 ? id.omega_rad_s : rec.omegaRadS();
     slow = rec.kind == RecordKind::kRaw ? demodulateRaw(rec.raw, omega, &input_notes) : rec.slow;
+    if (!(id.omega_rad_s > 0.0) && slow.omega_rad_s > 0.0) id.omega_rad_s = slow.omega_rad_s;
     x = explainFreeDecay(slow, options);
   } else {
     if (rec.kind != RecordKind::kForcedSweep)
