@@ -56,7 +56,9 @@ lines = [
     "- Date: %s" % datetime.datetime.now().strftime("%Y-%m-%d %H:%M"),
     "- Machine: %s, %s CPU(s) (%s core(s) per socket), %s MHz per Google Benchmark"
     % (lscpu("Model name"), lscpu("CPU(s)"), lscpu("Core(s) per socket"), ctx.get("mhz_per_cpu", "?")),
-    "- Build: %s; single thread; items/s from CPU time" % ctx.get("library_build_type", "?"),
+    "- Build: cvg_benchmarks in the project's Release build (-O3; hot kernels also cloned for "
+    "x86-64-v3); single thread; items/s from CPU time (libbenchmark itself reports '%s')"
+    % ctx.get("library_build_type", "?"),
     "- NumPy references: scripts/bench_numpy_*.py run in the same session (/usr/bin/python3, "
     "numpy %s), matched by name" % subprocess.run(
         ["/usr/bin/python3", "-c", "import numpy; print(numpy.__version__)"],
