@@ -109,19 +109,26 @@ Settled settle(const ForcedSystem& sys, double lambda, const Eigen::Vector4d& q_
   return s;
 }
 
-/// Natural-parameter continuation of the branch through q_prev at lambda_prev to lambda, in
-/// sub-steps; false when the branch ends (singular Jacobian, no convergence, or a sub-step that
-/// moves the state by more than a quarter of its size: Newton fell onto another branch).
+/// Natural-parameter continuation of the branch through q_prev at lambda_prev to lambda, with
+/// adaptive sub-steps: a Newton sub-step that moves the state by more than 10 % of its size is
+/// halved. False when the branch ends before lambda (a fold: the sub-step shrinks below 1/4096 of
+/// the step, the Jacobian is singular, or Newton fails).
 bool continueBranch(const ForcedSystem& sys, double lambda_prev, double lambda,
                     const Eigen::Vector4d& q_prev, Eigen::Vector4d& q_out) {
-  const int substeps = 8;
+  const double full = lambda - lambda_prev, min_step = std::abs(full) / 4096;
+  double l = lambda_prev, dl = full / 8;
   Eigen::Vector4d q = q_prev;
-  for (int k = 1; k <= substeps; ++k) {
-    const double l = lambda_prev + (lambda - lambda_prev) * k / substeps;
-    const NewtonResult r = solveStationary(sys, sys.rate(l), q);
-    if (!r.converged) return false;
-    if ((r.q - q).norm() > 0.25 * std::max(q.norm(), 1e-3 * sys.amplitude_scale)) return false;
+  while ((full > 0 && l < lambda) || (full < 0 && l > lambda)) {
+    if (std::abs(dl) < min_step) return false;
+    const double l_next = (full > 0) ? std::min(l + dl, lambda) : std::max(l + dl, lambda);
+    const NewtonResult r = solveStationary(sys, sys.rate(l_next), q);
+    if (!r.converged || (r.q - q).norm() > 0.1 * std::max(q.norm(), 1e-3 * sys.amplitude_scale)) {
+      dl *= 0.5;
+      continue;
+    }
     q = r.q;
+    l = l_next;
+    dl *= 1.5;
   }
   q_out = q;
   return true;
@@ -221,7 +228,10 @@ SweepResult ExperimentRunner::forcedSweep() const {
     step.q = s.q;
     step.settled = s.settled;
     step.settle_time_s = s.time_s;
-    if (k > 0) {
+    // Jumps are defined between stationary states only: an unsettled step (e.g. a limit cycle of
+    // the averaged equations after a Hopf instability) is reported as such instead.
+    const bool previous_settled = k > 0 && result.steps.back().settled;
+    if (previous_settled && s.settled) {
       Eigen::Vector4d q_cont;
       const bool on_branch =
           continueBranch(sys, order[k - 1].first, step.lambda_rad_s, q, q_cont) &&
@@ -361,6 +371,7 @@ AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOpti
     rec.q.push_back(s.q);
     rec.direction.push_back(s.direction);
     rec.jump.push_back(s.jump ? 1 : 0);
+    rec.extra["stationary"].push_back(s.settled ? 1.0 : 0.0);
   }
   noise.addTo(rec, q_std);
   md["noise_std"] = num(q_std);

@@ -7,7 +7,9 @@
 //    range; each step starts from the previous step's state and is settled by integrating the
 //    averaged model (3.3) until stationary, then polished by Newton. A nonlinear resonator is
 //    bistable near a fold: a step whose settled state is not the continuation of the previous
-//    step's branch (Newton continuation in sub-steps fails or ends elsewhere) is flagged as a jump.
+//    step's branch (Newton continuation in adaptive sub-steps fails or ends elsewhere) is flagged
+//    as a jump. A step that does not become stationary within settle_time_s (e.g. a limit cycle of
+//    the averaged equations of two coupled nonlinear modes) is reported as unsettled, not a jump.
 //    With sweep_down the sweep runs back down, and the detunings where the two branches differ are
 //    reported (hysteresis).
 // simulateExperiment() adds seeded noise and `# truth_<name>: value` metadata for tests.
@@ -30,8 +32,8 @@ struct SweepStep {
   double omega0_rad_s = 0.0;                    ///< drive frequency [rad/s]
   Eigen::Vector4d q = Eigen::Vector4d::Zero();  ///< stationary (q1, p1, q2, p2), noise-free
   int direction = 1;                            ///< +1 up-sweep, -1 down-sweep
-  bool jump = false;           ///< reached by a jump off the previous step's branch
-  bool settled = true;         ///< stationary within settle_time_s (else the last state)
+  bool jump = false;    ///< reached by a jump off the previous step's branch (both steps settled)
+  bool settled = true;  ///< stationary within settle_time_s (else the last state)
   double settle_time_s = 0.0;  ///< time the averaged model ran for this step [s]
 };
 
@@ -93,7 +95,8 @@ struct SimulationOptions {
 /// Runs the experiment, adds the noise and fills the metadata (omega, mode, preset, truth_model,
 /// truth_<parameter> for every parameter of the truth model, truth_mu, truth_eta, seed, noise_std,
 /// and for sweeps n_jumps, jump_lambdas_rad_s, hysteresis range). The kind of the result is
-/// kFreeDecay, kForcedSweep or kRaw.
+/// kFreeDecay, kForcedSweep or kRaw. Sweep records carry an extra column `stationary` (1 settled,
+/// 0 still moving after settle_time_s: the q written is the last state).
 AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOptions& options);
 
 }  // namespace cvg_bench
