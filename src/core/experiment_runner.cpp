@@ -25,8 +25,9 @@ struct ForcedSystem {
   Eigen::VectorXd z;
   double mu, omega, gamma, amplitude_scale;
 
-  explicit ForcedSystem(const ResonatorPreset& p)
-      : model(p.truthModelSpec(ExperimentMode::kForced), ExperimentMode::kForced),
+  /// pre_drive: the drive before a free decay, which ignores free-decay-only effects (cm_rate).
+  explicit ForcedSystem(const ResonatorPreset& p, bool pre_drive = false)
+      : model(p.truthModelSpec(ExperimentMode::kForced, pre_drive), ExperimentMode::kForced),
         z(p.truthParameters(model)),
         mu(p.mu),
         omega(p.omega_rad_s),
@@ -157,7 +158,7 @@ ExperimentRunner::ExperimentRunner(const ResonatorPreset& preset) : preset_(pres
 
 Eigen::Vector4d ExperimentRunner::stationaryForcedState(double lambda,
                                                         const Eigen::Vector4d& start) const {
-  const ForcedSystem sys(preset_);
+  const ForcedSystem sys(preset_, true);
   const Settled s = settle(sys, lambda, start, preset_.sweep_settle_tolerance,
                            50.0 * preset_.sweep_settle_time_s);
   if (!s.settled)

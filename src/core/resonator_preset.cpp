@@ -209,7 +209,7 @@ void ResonatorPreset::applyEffect(const std::string& assignment) {
   applyEffect(assignment.substr(0, eq), v);
 }
 
-std::string ResonatorPreset::truthModelSpec(ExperimentMode mode) const {
+std::string ResonatorPreset::truthModelSpec(ExperimentMode mode, bool skip_inapplicable) const {
   std::string spec = "linear";
   for (const auto& term_name : knownModelTermNames()) {
     if (term_name == "linear" || term_name == "controls") continue;
@@ -220,6 +220,7 @@ std::string ResonatorPreset::truthModelSpec(ExperimentMode mode) const {
       if (it != parameters.end() && it->second != 0.0) nonzero = true;
     }
     if (!nonzero) continue;
+    if (!term->appliesTo(mode) && skip_inapplicable) continue;
     if (!term->appliesTo(mode))
       throw InputError("effect '" + term_name + "' does not exist in " + experimentModeName(mode) +
                        " mode: set it to 0 (e.g. --effect " + term->parameterNames().front() +

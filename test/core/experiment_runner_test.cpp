@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/orbit_elements.h"
 
 namespace cvg_bench {
 namespace {
@@ -125,6 +126,25 @@ TEST(ExperimentRunner, SeededNoiseIsBitIdenticalAndHasTheRequestedStd) {
   // n = 1604 draws: the sample std is within 6 % (3.4 standard errors of 1/sqrt(2n)).
   EXPECT_NEAR(std::sqrt(sum_sq / n), p.noise_q_std, 0.06 * p.noise_q_std);
   EXPECT_EQ(a.slow.metadata.at("seed"), "7");
+}
+
+// cm_rate (frequency drift during the record) starts at t = 0 of the free decay: the forced
+// pre-drive ignores it, and by (5.10) it only advances the phase: chi gains cm_rate T^2 / 4 over
+// [0, T].
+TEST(ExperimentRunner, FrequencyDriftActsOnlyDuringTheFreeDecay) {
+  ResonatorPreset drifting = memsRing();
+  drifting.applyEffect("cm_rate=100");
+  const ResonatorPreset steady = memsRing();
+  const double duration = 0.1;
+  const SlowRecord a = ExperimentRunner(drifting).freeDecaySlow(duration);
+  const SlowRecord b = ExperimentRunner(steady).freeDecaySlow(duration);
+  EXPECT_LT((a.q.front() - b.q.front()).norm(), 1e-15);
+  const OrbitElements ea = orbitFromSlow(a.q.back()), eb = orbitFromSlow(b.q.back());
+  EXPECT_NEAR(ea.r, eb.r, 1e-6 * eb.r);
+  EXPECT_NEAR(std::remainder(ea.chi - eb.chi, 2 * M_PI), 100.0 * duration * duration / 4, 1e-5);
+  SimulationOptions forced;
+  forced.mode = ExperimentMode::kForced;
+  EXPECT_THROW(simulateExperiment(drifting, forced), InputError);
 }
 
 TEST(ExperimentRunner, MetadataCarryTheTruth) {

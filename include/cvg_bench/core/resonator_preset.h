@@ -74,7 +74,10 @@ struct ResonatorPreset {
   void applyEffect(const std::string& assignment);
   /// The truth model for a mode: `linear` plus every extension with a nonzero parameter.
   /// InputError when a nonzero parameter's term does not exist in that mode (cm_rate forced).
-  std::string truthModelSpec(ExperimentMode mode) const;
+  /// With skip_inapplicable, terms that do not exist in `mode` are left out instead of refused
+  /// (the forced pre-drive before a free decay ignores effects such as cm_rate that start at t =
+  /// 0).
+  std::string truthModelSpec(ExperimentMode mode, bool skip_inapplicable = false) const;
   /// z of the truth model (drive u~ included in forced mode).
   Eigen::VectorXd truthParameters(const ResonatorModel& model) const;
 };
