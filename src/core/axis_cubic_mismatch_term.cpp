@@ -3,6 +3,7 @@
 //   2 a' = (i xi_diff / 4)(2 N a + S conj(a)),  2 b' = -(i xi_diff / 4)(2 N b + S conj(b)).
 #include "cvg_bench/core/model_terms.h"
 #include "cvg_bench/core/slow_complex.h"
+#include "cvg_bench/core/slow_complex_jacobian.h"
 
 namespace cvg_bench {
 namespace {
@@ -21,6 +22,16 @@ class AxisCubicMismatchTerm : public ModelTerm {
     setComplexColumn(k * (2.0 * z.n_sq * z.a + z.s * std::conj(z.a)),
                      -k * (2.0 * z.n_sq * z.b + z.s * std::conj(z.b)), d, 0);
   }
+  void averagedJacobian(const Eigen::Vector4d& q, const SlowContext&,
+                        const Eigen::Ref<const Eigen::VectorXd>& z_term,
+                        Eigen::Matrix4d& jacobian) const override {
+    ComplexColumnDerivatives d = cubicColumnDerivatives(SlowComplex(q), 1.0);
+    d.b_a = -d.b_a;  // the g equation carries -xi_diff
+    d.b_ac = -d.b_ac;
+    d.b_b = -d.b_b;
+    d.b_bc = -d.b_bc;
+    setComplexJacobian(d, std::complex<double>(0.0, 0.25 * z_term[0]), jacobian);
+  }
   void fastColumns(const FastState& s, const FastContext& c,
                    Eigen::Ref<Eigen::MatrixXd> cols) const override {
     const double n = s.f * s.f + s.g * s.g;
@@ -31,6 +42,8 @@ class AxisCubicMismatchTerm : public ModelTerm {
 
 }  // namespace
 
-ModelTermPtr makeAxisCubicMismatchTerm() { return std::make_shared<AxisCubicMismatchTerm>(); }
+ModelTermPtr makeAxisCubicMismatchTerm() {
+  return std::make_shared<AxisCubicMismatchTerm>();
+}
 
 }  // namespace cvg_bench

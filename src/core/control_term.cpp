@@ -2,8 +2,9 @@
 // u3, u4. Parameters u~i = eta u_i / omega (tilde); mu is known (SlowContext/FastContext).
 // Averaged (3.2): 2 q' gets D_u z_u with D_u = E + mu D_n,
 //   D_n = [[k11, k9, 0, 0], [k9, k12, 0, 0], [0, 0, k13, k10], [0, 0, k10, k14]],
-//   k9 = -3 q1 p1 / 2, k10 = -3 q2 p2 / 2, k11 = 3 (3 p1^2 + q1^2) / 4, k12 = 3 (p1^2 + 3 q1^2) / 4,
-//   k13, k14 likewise with q2, p2 (derived: <f^2 sin^2> = (3 p^2 + q^2)/8, <f^2 sin cos> = q p / 4).
+//   k9 = -3 q1 p1 / 2, k10 = -3 q2 p2 / 2, k11 = 3 (3 p1^2 + q1^2) / 4, k12 = 3 (p1^2 + 3 q1^2) /
+//   4, k13, k14 likewise with q2, p2 (derived: <f^2 sin^2> = (3 p^2 + q^2)/8, <f^2 sin cos> = q p /
+//   4).
 // (The paper writes "E + alpha D_n"; alpha means mu, NOTES.md item 3.)
 #include <cmath>
 
@@ -36,9 +37,25 @@ class ControlTerm : public ModelTerm {
     d(3, 2) = mu * k10;
     d(3, 3) = 1 + mu * k14;
   }
+  // Only the mu D_n part depends on q: derivatives of k9..k14 above.
+  void averagedJacobian(const Eigen::Vector4d& q, const SlowContext& c,
+                        const Eigen::Ref<const Eigen::VectorXd>& u,
+                        Eigen::Matrix4d& jacobian) const override {
+    const double mu = c.mu;
+    jacobian.setZero();
+    for (int m = 0; m < 2; ++m) {
+      const double qm = q[2 * m], pm = q[2 * m + 1], ua = u[2 * m], ub = u[2 * m + 1];
+      // row 2m: ua (1 + mu k11) + ub mu k9; row 2m+1: ua mu k9 + ub (1 + mu k12).
+      jacobian(2 * m, 2 * m) = mu * (1.5 * qm * ua - 1.5 * pm * ub);
+      jacobian(2 * m, 2 * m + 1) = mu * (4.5 * pm * ua - 1.5 * qm * ub);
+      jacobian(2 * m + 1, 2 * m) = mu * (-1.5 * pm * ua + 4.5 * qm * ub);
+      jacobian(2 * m + 1, 2 * m + 1) = mu * (-1.5 * qm * ua + 1.5 * pm * ub);
+    }
+  }
   void fastColumns(const FastState& s, const FastContext& c,
                    Eigen::Ref<Eigen::MatrixXd> cols) const override {
-    const double w = c.omega_rad_s, sn = std::sin(c.drive_phase_rad), cs = std::cos(c.drive_phase_rad);
+    const double w = c.omega_rad_s, sn = std::sin(c.drive_phase_rad),
+                 cs = std::cos(c.drive_phase_rad);
     const double af = w * (1 + 3 * c.mu * s.f * s.f), ag = w * (1 + 3 * c.mu * s.g * s.g);
     cols.setZero();
     cols(0, 0) = -af * sn;
@@ -50,6 +67,8 @@ class ControlTerm : public ModelTerm {
 
 }  // namespace
 
-ModelTermPtr makeControlTerm() { return std::make_shared<ControlTerm>(); }
+ModelTermPtr makeControlTerm() {
+  return std::make_shared<ControlTerm>();
+}
 
 }  // namespace cvg_bench

@@ -21,6 +21,17 @@ class FrequencyDriftTerm : public ModelTerm {
     d(2, 0) = c.t_s * q[3];
     d(3, 0) = -c.t_s * q[2];
   }
+  // t cm_rate (p1, -q1, p2, -q2) is linear in q.
+  void averagedJacobian(const Eigen::Vector4d&, const SlowContext& c,
+                        const Eigen::Ref<const Eigen::VectorXd>& z_term,
+                        Eigen::Matrix4d& jacobian) const override {
+    const double r = c.t_s * z_term[0];
+    jacobian.setZero();
+    jacobian(0, 1) = r;
+    jacobian(1, 0) = -r;
+    jacobian(2, 3) = r;
+    jacobian(3, 2) = -r;
+  }
   void fastColumns(const FastState& s, const FastContext& c,
                    Eigen::Ref<Eigen::MatrixXd> cols) const override {
     cols(0, 0) = -c.omega_rad_s * c.t_s * s.f;
@@ -30,6 +41,8 @@ class FrequencyDriftTerm : public ModelTerm {
 
 }  // namespace
 
-ModelTermPtr makeFrequencyDriftTerm() { return std::make_shared<FrequencyDriftTerm>(); }
+ModelTermPtr makeFrequencyDriftTerm() {
+  return std::make_shared<FrequencyDriftTerm>();
+}
 
 }  // namespace cvg_bench

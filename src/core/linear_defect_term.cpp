@@ -27,6 +27,17 @@ class LinearDefectTerm : public ModelTerm {
     d.row(2) << -q2, -q1, q2, -q1, p2, -p1, -p2, p1;
     d.row(3) << -p2, -p1, p2, -p1, -q2, q1, q2, -q1;
   }
+  // D(q) z is linear in q: the Jacobian is the constant matrix of the rows above times z.
+  void averagedJacobian(const Eigen::Vector4d&, const SlowContext&,
+                        const Eigen::Ref<const Eigen::VectorXd>& z,
+                        Eigen::Matrix4d& jacobian) const override {
+    const double gamma = z[0], nu = z[1], b_c = z[2], b_s = z[3];
+    const double c_m = z[4], n = z[5], h_c = z[6], h_s = z[7];
+    jacobian << -gamma - b_c, c_m + h_c, nu - b_s, n + h_s,  //
+        -c_m - h_c, -gamma - b_c, -n - h_s, nu - b_s,        //
+        -nu - b_s, -n + h_s, -gamma + b_c, c_m - h_c,        //
+        n - h_s, -nu - b_s, -c_m + h_c, -gamma + b_c;
+  }
   void fastColumns(const FastState& s, const FastContext& c,
                    Eigen::Ref<Eigen::MatrixXd> cols) const override {
     const double w = c.omega_rad_s;
@@ -37,6 +48,8 @@ class LinearDefectTerm : public ModelTerm {
 
 }  // namespace
 
-ModelTermPtr makeLinearDefectTerm() { return std::make_shared<LinearDefectTerm>(); }
+ModelTermPtr makeLinearDefectTerm() {
+  return std::make_shared<LinearDefectTerm>();
+}
 
 }  // namespace cvg_bench

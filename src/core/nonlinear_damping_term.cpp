@@ -5,6 +5,7 @@
 // single mode: 2 a' = -(gamma_nl |a|^2 / 4) a, i.e. an effective damping gamma + gamma_nl A^2 / 4.
 #include "cvg_bench/core/model_terms.h"
 #include "cvg_bench/core/slow_complex.h"
+#include "cvg_bench/core/slow_complex_jacobian.h"
 
 namespace cvg_bench {
 namespace {
@@ -14,7 +15,8 @@ class NonlinearDampingTerm : public ModelTerm {
   std::string name() const override { return "gamma_nl"; }
   std::vector<std::string> parameterNames() const override { return {"gamma_nl"}; }
   std::string description() const override {
-    return "amplitude-dependent damping: decay rate grows with amplitude squared (air/thermoelastic "
+    return "amplitude-dependent damping: decay rate grows with amplitude squared "
+           "(air/thermoelastic "
            "or anchor loss nonlinearity)";
   }
   void averagedColumns(const Eigen::Vector4d& q, const SlowContext&,
@@ -22,6 +24,11 @@ class NonlinearDampingTerm : public ModelTerm {
     const SlowComplex z(q);
     setComplexColumn(-0.25 * (2.0 * z.n_sq * z.a - z.s * std::conj(z.a)),
                      -0.25 * (2.0 * z.n_sq * z.b - z.s * std::conj(z.b)), d, 0);
+  }
+  void averagedJacobian(const Eigen::Vector4d& q, const SlowContext&,
+                        const Eigen::Ref<const Eigen::VectorXd>& z_term,
+                        Eigen::Matrix4d& jacobian) const override {
+    setComplexJacobian(cubicColumnDerivatives(SlowComplex(q), -1.0), -0.25 * z_term[0], jacobian);
   }
   void fastColumns(const FastState& s, const FastContext&,
                    Eigen::Ref<Eigen::MatrixXd> cols) const override {
@@ -33,6 +40,8 @@ class NonlinearDampingTerm : public ModelTerm {
 
 }  // namespace
 
-ModelTermPtr makeNonlinearDampingTerm() { return std::make_shared<NonlinearDampingTerm>(); }
+ModelTermPtr makeNonlinearDampingTerm() {
+  return std::make_shared<NonlinearDampingTerm>();
+}
 
 }  // namespace cvg_bench

@@ -1,9 +1,10 @@
-// Quintic stiffness kappa (f^2 + g^2)^2 f (likewise g) of (2.2)/(2.3); parameter kappa~ = kappa / omega.
-// First-order averaging gives
+// Quintic stiffness kappa (f^2 + g^2)^2 f (likewise g) of (2.2)/(2.3); parameter kappa~ = kappa /
+// omega. First-order averaging gives
 //   2 a' = (i kappa~ / 8)((2 N^2 + |S|^2) a + 2 N S conj(a)),  likewise b;
 // single mode 2 q1' = -(5/8) kappa~ p1^5. The paper prints k5..k8 with 1/16 (NOTES.md item 1).
 #include "cvg_bench/core/model_terms.h"
 #include "cvg_bench/core/slow_complex.h"
+#include "cvg_bench/core/slow_complex_jacobian.h"
 
 namespace cvg_bench {
 namespace {
@@ -24,6 +25,12 @@ class QuinticStiffnessTerm : public ModelTerm {
     setComplexColumn(k * (c0 * z.a + c1 * std::conj(z.a)), k * (c0 * z.b + c1 * std::conj(z.b)), d,
                      0);
   }
+  void averagedJacobian(const Eigen::Vector4d& q, const SlowContext&,
+                        const Eigen::Ref<const Eigen::VectorXd>& z_term,
+                        Eigen::Matrix4d& jacobian) const override {
+    setComplexJacobian(quinticColumnDerivatives(SlowComplex(q)),
+                       std::complex<double>(0.0, 0.125 * z_term[0]), jacobian);
+  }
   void fastColumns(const FastState& s, const FastContext& c,
                    Eigen::Ref<Eigen::MatrixXd> cols) const override {
     const double n = s.f * s.f + s.g * s.g;
@@ -34,6 +41,8 @@ class QuinticStiffnessTerm : public ModelTerm {
 
 }  // namespace
 
-ModelTermPtr makeQuinticStiffnessTerm() { return std::make_shared<QuinticStiffnessTerm>(); }
+ModelTermPtr makeQuinticStiffnessTerm() {
+  return std::make_shared<QuinticStiffnessTerm>();
+}
 
 }  // namespace cvg_bench

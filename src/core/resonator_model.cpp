@@ -71,6 +71,7 @@ ResonatorModel::ResonatorModel(const std::string& spec, ExperimentMode mode) : m
     if (offset + t->numParameters() > kMaxModelParameters)
       throw InputError("model '" + spec + "' has too many parameters");
     offsets_.push_back(offset);
+    sizes_.push_back(t->numParameters());
     for (const auto& n : t->parameterNames()) names_.push_back(n);
     offset += t->numParameters();
   }
@@ -90,8 +91,35 @@ int ResonatorModel::indexOf(const std::string& name) const {
 void ResonatorModel::regressor(const Eigen::Vector4d& q, const SlowContext& ctx,
                                Eigen::Ref<Eigen::MatrixXd> d) const {
   for (size_t i = 0; i < terms_.size(); ++i) {
-    terms_[i]->averagedColumns(q, ctx, d.middleCols(offsets_[i], terms_[i]->numParameters()));
+    terms_[i]->averagedColumns(q, ctx, d.middleCols(offsets_[i], sizes_[i]));
   }
+}
+
+void ResonatorModel::regressorJacobian(const Eigen::Vector4d& q, const SlowContext& ctx,
+                                       const Eigen::Ref<const Eigen::VectorXd>& z,
+                                       Eigen::Matrix4d& jacobian) const {
+  if (z.size() != numParameters())
+    throw InputError("regressor Jacobian: " + std::to_string(z.size()) + " values for " +
+                     std::to_string(numParameters()) + " parameters of model " + spec());
+  jacobian.setZero();
+  Eigen::Matrix4d term_jacobian;
+  for (size_t i = 0; i < terms_.size(); ++i) {
+    terms_[i]->averagedJacobian(q, ctx, z.segment(offsets_[i], sizes_[i]), term_jacobian);
+    jacobian += term_jacobian;
+  }
+}
+
+Eigen::Matrix4d ResonatorModel::slowJacobian(const Eigen::Vector4d& q, const SlowContext& ctx,
+                                             const Eigen::VectorXd& z, double detuning_rate) const {
+  Eigen::Matrix4d g;
+  regressorJacobian(q, ctx, z, g);
+  // d(p1, -q1, p2, -q2)/dq
+  Eigen::Matrix4d dir = Eigen::Matrix4d::Zero();
+  dir(0, 1) = 1.0;
+  dir(1, 0) = -1.0;
+  dir(2, 3) = 1.0;
+  dir(3, 2) = -1.0;
+  return 0.5 * (g - detuning_rate * dir);
 }
 
 Eigen::MatrixXd ResonatorModel::regressor(const Eigen::Vector4d& q, const SlowContext& ctx) const {
@@ -112,7 +140,7 @@ Eigen::Vector2d ResonatorModel::fastForce(const FastState& s, const FastContext&
                                           const Eigen::VectorXd& z) const {
   Eigen::Matrix<double, 2, Eigen::Dynamic, 0, 2, kMaxModelParameters> cols(2, numParameters());
   for (size_t i = 0; i < terms_.size(); ++i) {
-    terms_[i]->fastColumns(s, ctx, cols.middleCols(offsets_[i], terms_[i]->numParameters()));
+    terms_[i]->fastColumns(s, ctx, cols.middleCols(offsets_[i], sizes_[i]));
   }
   return cols * z;
 }

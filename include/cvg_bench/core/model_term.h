@@ -7,7 +7,8 @@
 //  - averagedColumns: its first-order Krylov-Bogoliubov average in the van der Pol variables (2.4),
 //        2 q' = averagedColumns * z_term,  q = (q1, p1, q2, p2).
 // The averaged view must equal the first-harmonic projection of the fast view,
-//   2 q1' = -(2/omega) <F_f sin(omega t)>,  2 p1' = (2/omega) <F_f cos(omega t)>  (likewise q2, p2 from F_g),
+//   2 q1' = -(2/omega) <F_f sin(omega t)>,  2 p1' = (2/omega) <F_f cos(omega t)>  (likewise q2, p2
+//   from F_g),
 // which test/core/model_term_averaging_test.cpp checks term by term by quadrature.
 // Tilde quantities (stiffness-type coefficients divided by omega) are stored under the plain name;
 // fastColumns multiplies them back by omega.
@@ -65,6 +66,17 @@ class ModelTerm {
   /// 2 x k columns of the generalized force in the full equations (2.3)/(3.1).
   virtual void fastColumns(const FastState& s, const FastContext& ctx,
                            Eigen::Ref<Eigen::MatrixXd> cols) const = 0;
+  /// 4 x 4 Jacobian d(averagedColumns(q) z_term)/dq (columns: d/dq1, d/dp1, d/dq2, d/dp2) for the
+  /// term's parameters z_term (k entries). The default is central differences of averagedColumns;
+  /// the terms override it analytically (checked against central differences by
+  /// test/core/model_term_jacobian_test.cpp).
+  virtual void averagedJacobian(const Eigen::Vector4d& q, const SlowContext& ctx,
+                                const Eigen::Ref<const Eigen::VectorXd>& z_term,
+                                Eigen::Matrix4d& jacobian) const;
+  /// The same by central differences of averagedColumns (the reference for the analytic forms).
+  void averagedJacobianNumerical(const Eigen::Vector4d& q, const SlowContext& ctx,
+                                 const Eigen::Ref<const Eigen::VectorXd>& z_term,
+                                 Eigen::Matrix4d& jacobian) const;
   int numParameters() const { return static_cast<int>(parameterNames().size()); }
 };
 

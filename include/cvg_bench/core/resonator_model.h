@@ -7,7 +7,8 @@
 //   forced mode  u1..u4 [1/s x amplitude, tilde = eta u_i / omega];
 //   extensions   xi, kappa, xi_diff [tilde, 1/(s amplitude^2), 1/(s amplitude^4)], gamma_nl
 //                [1/(s amplitude^2)], cm_rate [1/s^2, tilde].
-// Amplitudes are in the record's units (normalized by the maximum amplitude in the paper's section 4).
+// Amplitudes are in the record's units (normalized by the maximum amplitude in the paper's section
+// 4).
 #pragma once
 
 #include <Eigen/Core>
@@ -64,6 +65,16 @@ class ResonatorModel {
   Eigen::Vector4d slowDerivative(const Eigen::Vector4d& q, const SlowContext& ctx,
                                  const Eigen::VectorXd& z, double detuning_rate = 0.0) const;
 
+  /// G = d(D(q) z)/dq, 4 x 4 (columns d/dq1, d/dp1, d/dq2, d/dp2): the sum of the terms'
+  /// averagedJacobian (analytic); the linearization of (2.6)/(3.3) in the state, e.g. for the
+  /// errors-in-variables covariance of the identification.
+  void regressorJacobian(const Eigen::Vector4d& q, const SlowContext& ctx,
+                         const Eigen::Ref<const Eigen::VectorXd>& z,
+                         Eigen::Matrix4d& jacobian) const;
+  /// d q' / dq of slowDerivative (with the same detuning_rate), 4 x 4.
+  Eigen::Matrix4d slowJacobian(const Eigen::Vector4d& q, const SlowContext& ctx,
+                               const Eigen::VectorXd& z, double detuning_rate = 0.0) const;
+
   /// Generalized forces (F_f, F_g) of the full equations (2.3)/(3.1):
   /// f'' + omega^2 f = F_f, g'' + omega^2 g = F_g.
   Eigen::Vector2d fastForce(const FastState& s, const FastContext& ctx,
@@ -80,6 +91,7 @@ class ResonatorModel {
   std::vector<std::string> extensions_;
   std::vector<ModelTermPtr> terms_;
   std::vector<int> offsets_;
+  std::vector<int> sizes_;  ///< number of parameters of each term (cached: no per-call lookups)
   std::vector<std::string> names_;
 };
 
