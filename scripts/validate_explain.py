@@ -23,7 +23,8 @@ import time
 LIBRARY = {
     "forced": [None, ("xi", 18.217), ("kappa", 5.0), ("gamma_nl", 8.0), ("xi_diff", 3.0),
                ("mu", 0.05)],
-    "free_decay": [None, ("xi", 30.0), ("kappa", 30.0), ("gamma_nl", 12.0), ("xi_diff", 10.0)],
+    "free_decay": [None, ("xi", 30.0), ("kappa", 30.0), ("gamma_nl", 12.0), ("xi_diff", 10.0),
+                   ("cm_rate", 100.0)],
 }
 
 
