@@ -84,8 +84,10 @@ struct FittedProblem {
   ceres::Problem* problem = nullptr;
   std::vector<double*> blocks;  ///< parameter blocks, reported ones first
   std::vector<int> block_sizes;
-  std::vector<std::string> all_names;               ///< flattened names of all unknowns
-  int n_reported = 0;                               ///< leading unknowns reported as parameters
+  std::vector<std::string> all_names;  ///< flattened names of all unknowns
+  int n_reported = 0;                  ///< leading unknowns reported as parameters
+  /// Per flattened unknown: the blocks hold unknown / scale (empty = no scaling).
+  Eigen::VectorXd scale;
   const std::vector<Eigen::Vector4d>* q = nullptr;  ///< measured points (excitation summary)
 };
 
@@ -132,7 +134,10 @@ void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estima
   ceres::CRSMatrix crs;
   if (!fp.problem->Evaluate(eo, &cost, &residuals, nullptr, &crs))
     throw AnalysisError("Ceres refinement: residuals cannot be evaluated at the solution");
-  const Eigen::MatrixXd j = denseJacobian(crs);
+  Eigen::MatrixXd j = denseJacobian(crs);
+  const Eigen::VectorXd scale =
+      fp.scale.size() == j.cols() ? fp.scale : Eigen::VectorXd::Ones(j.cols());
+  j = j * scale.cwiseInverse().asDiagonal();  // with respect to the unscaled unknowns
   if (!j.allFinite()) throw AnalysisError("Ceres refinement: non-finite Jacobian at the solution");
   const int n = j.rows(), p = j.cols();
 
@@ -164,12 +169,14 @@ void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estima
     throw AnalysisError(
         "Ceres refinement: covariance could not be computed (Jacobian too ill-conditioned for "
         "min_reciprocal_condition_number)");
-  const Eigen::MatrixXd full_cov = sigma2 * Eigen::MatrixXd(cov);
+  const Eigen::MatrixXd full_cov =
+      sigma2 * scale.asDiagonal() * Eigen::MatrixXd(cov) * scale.asDiagonal();
 
   Eigen::VectorXd x(p);
   for (size_t b = 0, o = 0; b < fp.blocks.size(); o += fp.block_sizes[b], ++b)
     x.segment(o, fp.block_sizes[b]) =
         Eigen::Map<const Eigen::VectorXd>(fp.blocks[b], fp.block_sizes[b]);
+  x = x.cwiseProduct(scale);  // back to the unscaled unknowns
 
   const int k = fp.n_reported;
   const double s_p = studentQuantile(options.confidence, dof);
@@ -272,12 +279,29 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
                      " samples: too few for " + std::to_string(k) +
                      " parameters + 4 initial values");
 
-  Eigen::VectorXd z = startVector(model, start);
-  Eigen::Vector4d q0 = record.q.front();
+  // Unknowns scaled to O(1): z_j = z_scale_j x_j with z_scale_j = max(|start_j|, its standard
+  // error), q(t0) = q0_scale x_q with q0_scale = the record's largest |q|.
+  const Eigen::VectorXd z_start = startVector(model, start);
+  Eigen::VectorXd z_scale(k);
+  for (int i = 0; i < k; ++i) {
+    const auto it = start.parameters.find(model.parameterNames()[i]);
+    const double se = it != start.parameters.end() && std::isfinite(it->second.std_error)
+                          ? it->second.std_error
+                          : 0.0;
+    z_scale[i] = std::max(std::abs(z_start[i]), se);
+    if (!(z_scale[i] > 0)) z_scale[i] = 1.0;
+  }
+  double q0_scale = 0.0;
+  for (const auto& q : record.q) q0_scale = std::max(q0_scale, q.norm());
+  if (!(q0_scale > 0)) q0_scale = 1.0;
+  Eigen::VectorXd z = z_start.cwiseQuotient(z_scale);
+  Eigen::Vector4d q0 = record.q.front() / q0_scale;
   ceres::Problem problem;
   problem.AddResidualBlock(
-      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps).release(), nullptr,
-      z.data(), q0.data());
+      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps, NumericDerivative::kCentral,
+                                   z_scale, q0_scale)
+          .release(),
+      nullptr, z.data(), q0.data());
   ceres::Solver::Summary summary;
   solveOrThrow(&problem, options, &summary);
 
@@ -291,7 +315,8 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
       " estimate: averaged model (2.6) integrated by RK4 on the record's time grid (" +
       std::to_string(options.rk4_substeps) +
       " step(s) per sample interval), central numeric derivatives");
-  e.notes.push_back("fitted initial slow variables q(t0) = " + formatQ(q0.data()) +
+  const Eigen::Vector4d q0_fitted = q0_scale * q0;
+  e.notes.push_back("fitted initial slow variables q(t0) = " + formatQ(q0_fitted.data()) +
                     " (4 nuisance unknowns, not in parameters)");
   e.notes.push_back(kSigmaNote);
   e.notes.push_back(solverNote(summary));
@@ -300,7 +325,8 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
   // coarse for a clean rank decision and null space.
   ceres::Problem final_problem;
   final_problem.AddResidualBlock(
-      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps, NumericDerivative::kRidders)
+      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps, NumericDerivative::kRidders,
+                                   z_scale, q0_scale)
           .release(),
       nullptr, z.data(), q0.data());
   FittedProblem fp;
@@ -310,6 +336,8 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
   fp.all_names = model.parameterNames();
   for (const char* n : {"q1_0", "p1_0", "q2_0", "p2_0"}) fp.all_names.push_back(n);
   fp.n_reported = k;
+  fp.scale.resize(k + 4);
+  fp.scale << z_scale, Eigen::Vector4d::Constant(q0_scale);
   fp.q = &record.q;
   finishEstimate(fp, options, &e);
   return e;

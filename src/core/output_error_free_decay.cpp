@@ -32,12 +32,18 @@ bool integrateSlowTrajectory(const ResonatorModel& model, const Eigen::VectorXd&
 }
 
 FreeDecayOutputError::FreeDecayOutputError(const ResonatorModel& model, const SlowRecord& record,
-                                           int substeps)
-    : model_(model), record_(record), substeps_(substeps) {}
+                                           int substeps, const Eigen::VectorXd& z_scale,
+                                           double q0_scale)
+    : model_(model),
+      record_(record),
+      substeps_(substeps),
+      z_scale_(z_scale.size() == 0 ? Eigen::VectorXd::Ones(model.numParameters()) : z_scale),
+      q0_scale_(q0_scale) {}
 
 bool FreeDecayOutputError::operator()(double const* const* parameters, double* residuals) const {
-  const Eigen::Map<const Eigen::VectorXd> z(parameters[0], model_.numParameters());
-  const Eigen::Map<const Eigen::Vector4d> q0(parameters[1]);
+  const Eigen::VectorXd z = z_scale_.cwiseProduct(
+      Eigen::Map<const Eigen::VectorXd>(parameters[0], model_.numParameters()));
+  const Eigen::Vector4d q0 = q0_scale_ * Eigen::Map<const Eigen::Vector4d>(parameters[1]);
   thread_local std::vector<Eigen::Vector4d> trajectory;
   if (!integrateSlowTrajectory(model_, z, q0, record_.t_s, substeps_, &trajectory)) return false;
   for (size_t i = 0; i < record_.size(); ++i) {
@@ -51,8 +57,9 @@ namespace {
 
 template <ceres::NumericDiffMethodType kMethod>
 std::unique_ptr<ceres::CostFunction> makeCost(const ResonatorModel& model, const SlowRecord& record,
-                                              int substeps) {
-  auto* functor = new FreeDecayOutputError(model, record, substeps);
+                                              int substeps, const Eigen::VectorXd& z_scale,
+                                              double q0_scale) {
+  auto* functor = new FreeDecayOutputError(model, record, substeps, z_scale, q0_scale);
   const int n_residuals = functor->numResiduals();
   auto cost =
       std::make_unique<ceres::DynamicNumericDiffCostFunction<FreeDecayOutputError, kMethod>>(
@@ -65,13 +72,12 @@ std::unique_ptr<ceres::CostFunction> makeCost(const ResonatorModel& model, const
 
 }  // namespace
 
-std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(const ResonatorModel& model,
-                                                                  const SlowRecord& record,
-                                                                  int substeps,
-                                                                  NumericDerivative derivative) {
+std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(
+    const ResonatorModel& model, const SlowRecord& record, int substeps,
+    NumericDerivative derivative, const Eigen::VectorXd& z_scale, double q0_scale) {
   if (derivative == NumericDerivative::kRidders)
-    return makeCost<ceres::RIDDERS>(model, record, substeps);
-  return makeCost<ceres::CENTRAL>(model, record, substeps);
+    return makeCost<ceres::RIDDERS>(model, record, substeps, z_scale, q0_scale);
+  return makeCost<ceres::CENTRAL>(model, record, substeps, z_scale, q0_scale);
 }
 
 }  // namespace cvg_bench

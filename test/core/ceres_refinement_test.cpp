@@ -119,6 +119,21 @@ TEST(CeresRefinement, NoiselessFreeDecayGivesTruth) {
   EXPECT_LT(e.sigma, 1e-8);
 }
 
+TEST(CeresRefinement, FreeDecayWorksInAnyAmplitudeUnit) {
+  // The same record in pixels (x 200): gamma unchanged, xi scales by 1 / 200^2. The unknowns are
+  // scaled internally, so the fixed floors of Ceres' difference steps do not matter.
+  const double a = 200.0;
+  SlowRecord record = freeDecayRecord("xi", kFreeTruth, kQ0, 0.0, 1);
+  for (auto& q : record.q) q *= a;
+  ParameterValues truth = kFreeTruth;
+  truth["xi"] /= a * a;
+  Estimate start = startEstimate("xi", ExperimentMode::kFreeDecay, truth, 0.0);
+  start.values *= 1.05;  // relative perturbation only (absolute offsets would be huge for xi)
+  const Estimate e = refineWithCeres(record, start);
+  EXPECT_NEAR(e.parameters.at("gamma").value, 0.5, 1e-6);
+  EXPECT_NEAR(e.parameters.at("xi").value * a * a, 0.6, 1e-6);
+}
+
 TEST(CeresRefinement, NoisyFreeDecayTruthInsideIntervals) {
   const double sigma_q = 2e-3;
   const SlowRecord record = freeDecayRecord("xi", kFreeTruth, kQ0, sigma_q, 7);

@@ -27,11 +27,16 @@ bool integrateSlowTrajectory(const ResonatorModel& model, const Eigen::VectorXd&
                              const Eigen::Vector4d& q0, const std::vector<double>& t_s,
                              int substeps, std::vector<Eigen::Vector4d>* trajectory);
 
-/// The residual functor: parameter blocks (z [numParameters()], q(t_0) [4]).
+/// The residual functor: parameter blocks (z [numParameters()], q(t_0) [4]), each in units of its
+/// scale: z = z_scale .* x_z, q(t_0) = q0_scale * x_q. Scaling makes the unknowns O(1), so the
+/// numeric-difference steps (which have absolute floors in Ceres) suit any amplitude unit (pixels,
+/// volts) and parameter size.
 class FreeDecayOutputError {
  public:
-  /// Keeps references to model and record: both must outlive the functor.
-  FreeDecayOutputError(const ResonatorModel& model, const SlowRecord& record, int substeps);
+  /// Keeps references to model and record: both must outlive the functor. z_scale: numParameters()
+  /// positive entries (empty = all 1); q0_scale > 0.
+  FreeDecayOutputError(const ResonatorModel& model, const SlowRecord& record, int substeps,
+                       const Eigen::VectorXd& z_scale = Eigen::VectorXd(), double q0_scale = 1.0);
   bool operator()(double const* const* parameters, double* residuals) const;
   int numResiduals() const { return 4 * static_cast<int>(record_.size()); }
 
@@ -39,6 +44,8 @@ class FreeDecayOutputError {
   const ResonatorModel& model_;
   const SlowRecord& record_;
   int substeps_;
+  Eigen::VectorXd z_scale_;
+  double q0_scale_;
 };
 
 /// How the Jacobian of the trajectory residuals is differenced.
@@ -48,9 +55,10 @@ enum class NumericDerivative {
              ///< covariance and the rank decision
 };
 
-/// The Ceres cost function over blocks (z, q(t_0)).
+/// The Ceres cost function over the scaled blocks (x_z, x_q) of FreeDecayOutputError.
 std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(
     const ResonatorModel& model, const SlowRecord& record, int substeps,
-    NumericDerivative derivative = NumericDerivative::kCentral);
+    NumericDerivative derivative = NumericDerivative::kCentral,
+    const Eigen::VectorXd& z_scale = Eigen::VectorXd(), double q0_scale = 1.0);
 
 }  // namespace cvg_bench
