@@ -50,8 +50,13 @@ bool hasUniformTimes(const SlowRecord& record, double relative_tolerance) {
 void forEachFreeDecayBlock(const ResonatorModel& model, const SlowRecord& record,
                            double uniform_time_tolerance, const RegressionVisitor& visit) {
   validateFreeDecayRecord(record);
+  forEachValidatedFreeDecayBlock(model, record, hasUniformTimes(record, uniform_time_tolerance),
+                                 visit);
+}
+
+void forEachValidatedFreeDecayBlock(const ResonatorModel& model, const SlowRecord& record,
+                                    bool simpson, const RegressionVisitor& visit) {
   const int k = model.numParameters();
-  const bool simpson = hasUniformTimes(record, uniform_time_tolerance);
   const double t0 = record.t_s[0];
   // Rolling window of D(q) at samples i-1, i, i+1.
   RegressionBlockMatrix dm[3] = {RegressionBlockMatrix(4, k), RegressionBlockMatrix(4, k),

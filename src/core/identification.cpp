@@ -140,74 +140,76 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
     //   A_i,i-1 = -2 I - w_i,i-1 G_i-1,  G = d(D(q) z)/dq,  w the quadrature weights of D-bar_i;
     // D' Omega D = sigma_q^2 sum_m W_m W_m',  W_m = sum_i D-bar_i' A_im (telescopes: small inside
     // the record, O(1) at its ends); sigma_q^2 = RSS / sum ||A_im||_F^2 x n / (n - k).
-    using Mk4 = Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::ColMajor, kMaxModelParameters, 4>;
+    // Per sample, W_m' = U_m - G_m' V_m with U_m = 2 (D-bar_{m-1} - D-bar_{m+1}) and
+    // V_m = sum_i w_im D-bar_i (4 x k each), so G_m (analytic, ResonatorModel::regressorJacobian)
+    // is evaluated once per sample; ||s I - w G||^2 = 4 s^2 - 2 s w tr G + w^2 ||G||^2.
     const ResonatorModel& model = *info.resonator;
-    auto jacobian = [&](const Eigen::Vector4d& q, double t) {
-      SlowContext ctx;
-      ctx.t_s = t;
-      const Eigen::Vector4d base = model.slowDerivative(q, ctx, z);
-      Eigen::Matrix4d g;
-      for (int col = 0; col < 4; ++col) {
-        Eigen::Vector4d qq = q;
-        const double step = 1e-6 * std::max(q.cwiseAbs().maxCoeff(), 1e-12);
-        qq[col] += step;
-        g.col(col) = 2.0 * (model.slowDerivative(qq, ctx, z) - base) / step;
-      }
-      return g;
+    struct SampleTerms {
+      RegressionBlockMatrix u, v;
+      double s2 = 0.0, sw = 0.0, w2 = 0.0;  // sums of s^2, s w, w^2 over the sample's blocks
     };
+    SampleTerms acc[3];
+    for (auto& a : acc) {
+      a.u.setZero(4, k);
+      a.v.setZero(4, k);
+    }
     constexpr int kBatch = 64;
     Eigen::MatrixXd wbuf(k, 4 * kBatch), meat = Eigen::MatrixXd::Zero(k, k);
     int in_buf = 0;
-    auto push = [&](const Mk4& w) {
-      wbuf.middleCols<4>(4 * in_buf) = w;
+    double tr_a = 0.0, lag2 = 0.0;
+    Eigen::Matrix4d g;
+    RegressionBlockMatrix x(4, k);
+    SlowContext jctx;
+    // Sample complete: G at (q, t), W_m' into the batch, its share of sum ||A_im||^2.
+    auto finish = [&](SampleTerms& a, const Eigen::Vector4d& q, double t) {
+      jctx.t_s = t;
+      model.regressorJacobian(q, jctx, z, g);
+      x.noalias() = a.u - g.transpose() * a.v;
+      wbuf.middleCols<4>(4 * in_buf) = x.transpose();
       if (++in_buf == kBatch) {
-        meat.noalias() += wbuf * wbuf.transpose();
+        meat.selfadjointView<Eigen::Lower>().rankUpdate(wbuf);
         in_buf = 0;
       }
+      tr_a += 4.0 * a.s2 - 2.0 * a.sw * g.trace() + a.w2 * g.squaredNorm();
+      a.u.setZero();
+      a.v.setZero();
+      a.s2 = a.sw = a.w2 = 0.0;
     };
-    Mk4 w[3] = {Mk4::Zero(k, 4), Mk4::Zero(k, 4), Mk4::Zero(k, 4)};
-    Eigen::Matrix4d g[3];
-    bool fresh = true;
-    double tr_a = 0.0, lag2 = 0.0;
     Eigen::Vector4d r_hist[2] = {Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
     long in_record = 0;
-    const Eigen::Matrix4d two = 2.0 * Eigen::Matrix4d::Identity();
     stream([&](int, const RegressionBlock& b) {
-      const Eigen::Vector4d r = b.y - (*b.d) * z;
+      const RegressionBlockMatrix& d = *b.d;
+      const Eigen::Vector4d r = b.y - d * z;
       rss += r.squaredNorm();
-      if (fresh) {
-        g[0] = jacobian(b.q_prev, b.t_prev);
-        g[1] = jacobian(b.q, b.abscissa);
-        for (auto& x : w) x.setZero();
-        in_record = 0;
-        fresh = false;
-      }
       if (in_record >= 2) lag2 += r.dot(r_hist[1]);
       r_hist[1] = r_hist[0];
       r_hist[0] = r;
+      // Block i = in_record + 1 of the record uses samples i-1, i, i+1 (slots by sample mod 3).
+      SampleTerms& prev = acc[in_record % 3];
+      SampleTerms& mid = acc[(in_record + 1) % 3];
+      SampleTerms& next = acc[(in_record + 2) % 3];
+      prev.u.noalias() -= 2.0 * d;
+      prev.v.noalias() += b.weights[0] * d;
+      prev.s2 += 4.0;
+      prev.sw -= 2.0 * b.weights[0];
+      prev.w2 += b.weights[0] * b.weights[0];
+      mid.v.noalias() += b.weights[1] * d;
+      mid.w2 += b.weights[1] * b.weights[1];
+      next.u.noalias() += 2.0 * d;
+      next.v.noalias() += b.weights[2] * d;
+      next.s2 += 4.0;
+      next.sw += 2.0 * b.weights[2];
+      next.w2 += b.weights[2] * b.weights[2];
+      finish(prev, b.q_prev, b.t_prev);  // sample i-1 appears in no later block
       ++in_record;
-      g[2] = jacobian(b.q_next, b.t_next);
-      const Eigen::Matrix4d a_prev = -two - b.weights[0] * g[0];
-      const Eigen::Matrix4d a_mid = -b.weights[1] * g[1];
-      const Eigen::Matrix4d a_next = two - b.weights[2] * g[2];
-      const auto dt = b.d->transpose();
-      w[0].noalias() += dt * a_prev;
-      w[1].noalias() += dt * a_mid;
-      w[2].noalias() += dt * a_next;
-      tr_a += a_prev.squaredNorm() + a_mid.squaredNorm() + a_next.squaredNorm();
-      push(w[0]);  // W_{i-1} gets no later contribution
-      w[0] = w[1];
-      w[1] = w[2];
-      w[2].setZero();
-      g[0] = g[1];
-      g[1] = g[2];
       if (b.last_in_record) {
-        push(w[0]);
-        push(w[1]);
-        fresh = true;
+        finish(mid, b.q, b.abscissa);
+        finish(next, b.q_next, b.t_next);
+        in_record = 0;
       }
     });
-    meat.noalias() += wbuf.leftCols(4 * in_buf) * wbuf.leftCols(4 * in_buf).transpose();
+    if (in_buf > 0) meat.selfadjointView<Eigen::Lower>().rankUpdate(wbuf.leftCols(4 * in_buf));
+    meat.triangularView<Eigen::StrictlyUpper>() = meat.transpose();
     const double sigma_q2 = tr_a > 0.0 ? rss / tr_a * static_cast<double>(n) / dof_paper : 0.0;
     honest = sigma_q2 * c * meat * c;
     e.interval_method =
@@ -344,12 +346,11 @@ std::vector<std::string> IdentificationOptions::validate() const {
   return p;
 }
 
-Estimate identifyFreeDecay(const SlowRecord& record, const IdentificationOptions& options) {
-  return identifyFreeDecay(std::vector<SlowRecord>{record}, options);
-}
+namespace {
 
-Estimate identifyFreeDecay(const std::vector<SlowRecord>& records,
-                           const IdentificationOptions& options) {
+/// Free decay over records given by pointer (the single-record overload copies nothing).
+Estimate identifyFreeDecayRecords(const std::vector<const SlowRecord*>& records,
+                                  const IdentificationOptions& options) {
   throwIfInvalid(options);
   if (records.empty()) throw InputError("no free-decay record given");
   const ResonatorModel model(options.model, ExperimentMode::kFreeDecay);
@@ -359,26 +360,41 @@ Estimate identifyFreeDecay(const std::vector<SlowRecord>& records,
   info.names = model.parameterNames();
   info.max_lag_blocks = 2;
   info.resonator = &model;
-  info.omega_rad_s = resolveOmega(options.omega_rad_s, records[0].omega_rad_s, false, "");
+  info.omega_rad_s = resolveOmega(options.omega_rad_s, records[0]->omega_rad_s, false, "");
+  std::vector<bool> simpson(records.size());
   for (size_t r = 0; r < records.size(); ++r) {
-    validateFreeDecayRecord(records[r]);
-    const bool simpson = hasUniformTimes(records[r], options.uniform_time_tolerance);
+    const SlowRecord& rec = *records[r];
+    validateFreeDecayRecord(rec);
+    simpson[r] = hasUniformTimes(rec, options.uniform_time_tolerance);
     info.notes.push_back(
-        (records[r].source.empty() ? "record " + std::to_string(r) : records[r].source) + ": " +
-        std::to_string(records[r].size()) +
-        " samples, integral of D(q) over [t_{i-1}, t_{i+1}] by " +
-        (simpson ? "Simpson's rule (uniform times)" : "the trapezoid rule (irregular times)") +
+        (rec.source.empty() ? "record " + std::to_string(r) : rec.source) + ": " +
+        std::to_string(rec.size()) + " samples, integral of D(q) over [t_{i-1}, t_{i+1}] by " +
+        (simpson[r] ? "Simpson's rule (uniform times)" : "the trapezoid rule (irregular times)") +
         ", y_i = 2 (q_{i+1} - q_{i-1}) (factor 1/2 of (2.7) kept)");
   }
   if (records.size() > 1)
     info.notes.push_back(std::to_string(records.size()) + " records stacked into one regression");
   const BlockStream stream = [&](const BlockSink& sink) {
     for (size_t r = 0; r < records.size(); ++r) {
-      forEachFreeDecayBlock(model, records[r], options.uniform_time_tolerance,
-                            [&](const RegressionBlock& b) { sink(static_cast<int>(r), b); });
+      forEachValidatedFreeDecayBlock(model, *records[r], simpson[r], [&](const RegressionBlock& b) {
+        sink(static_cast<int>(r), b);
+      });
     }
   };
   return runEstimator(stream, info, options);
+}
+
+}  // namespace
+
+Estimate identifyFreeDecay(const SlowRecord& record, const IdentificationOptions& options) {
+  return identifyFreeDecayRecords({&record}, options);
+}
+
+Estimate identifyFreeDecay(const std::vector<SlowRecord>& records,
+                           const IdentificationOptions& options) {
+  std::vector<const SlowRecord*> pointers;
+  for (const auto& r : records) pointers.push_back(&r);
+  return identifyFreeDecayRecords(pointers, options);
 }
 
 Estimate identifyForced(const SweepRecord& record, const IdentificationOptions& options) {

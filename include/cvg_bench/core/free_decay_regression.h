@@ -40,5 +40,10 @@ bool hasUniformTimes(const SlowRecord& record, double relative_tolerance);
 /// Calls visit for each block i = 1..N-1 of the record (validated first).
 void forEachFreeDecayBlock(const ResonatorModel& model, const SlowRecord& record,
                            double uniform_time_tolerance, const RegressionVisitor& visit);
+/// The same for a record already checked by validateFreeDecayRecord, with the quadrature chosen
+/// (simpson = hasUniformTimes(record, tolerance)): for repeated passes over long records.
+/// D(q) is evaluated once per sample (rolling window of 3).
+void forEachValidatedFreeDecayBlock(const ResonatorModel& model, const SlowRecord& record,
+                                    bool simpson, const RegressionVisitor& visit);
 
 }  // namespace cvg_bench
