@@ -1,0 +1,58 @@
+// resonator_simulator_node: a simulated resonator on the bench. Runs the core's experiments
+// (experiment_runner.h) on a preset and streams them in (scaled) real time:
+//   raw             RawSampleBatch  raw f, g of the full equations, with noise (free decay)
+//   sim/slow        SlowState       averaged-model slow variables, with noise (free decay)
+//   sim/slow_truth  SlowState       the same without noise
+//   sweep           SweepPoint      settled points of a forced sweep, with noise
+//   truth           SimulationTruth latched: preset, true parameters, noise levels
+// Services start_free_decay and start_sweep start an experiment (the previous one stops).
+// Stamps are start + simulated time; the start is the phase epoch of (2.4).
+#pragma once
+
+#include <ros/ros.h>
+
+#include "cvg_bench/StartFreeDecay.h"
+#include "cvg_bench/StartSweep.h"
+#include "cvg_bench/core/records.h"
+#include "cvg_bench/core/resonator_preset.h"
+#include "cvg_bench/ros/simulator_node_options.h"
+
+namespace cvg_bench {
+
+class SimulatorNode {
+ public:
+  /// Reads the settings from pnh and the preset; throws InputError listing every problem.
+  SimulatorNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh);
+
+ private:
+  enum class Running { kNone, kFreeDecay, kSweep };
+
+  bool onStartFreeDecay(StartFreeDecay::Request& req, StartFreeDecay::Response& res);
+  bool onStartSweep(StartSweep::Request& req, StartSweep::Response& res);
+  /// Simulates the whole record now (InputError / AnalysisError from the core pass through).
+  void startFreeDecay(double duration_s, int seed);
+  void startSweep(const ResonatorPreset& preset, int seed);
+  void beginStreaming(Running what, ExperimentMode mode, const ResonatorPreset& preset);
+  void onTick(const ros::WallTimerEvent&);
+  void publishDueFreeDecay(double due_s);
+  void publishDueSweep(double wall_elapsed_s);
+
+  ros::NodeHandle nh_;
+  SimulatorNodeOptions options_;
+  ResonatorPreset preset_;  ///< as loaded, noise scaled by options_.noise_scale
+
+  ros::Publisher raw_pub_, slow_pub_, slow_truth_pub_, sweep_pub_, truth_pub_;
+  ros::ServiceServer start_free_decay_srv_, start_sweep_srv_;
+  ros::WallTimer timer_;
+
+  Running running_ = Running::kNone;
+  RawRecord raw_;
+  SlowRecord slow_, slow_truth_;
+  SweepRecord sweep_;
+  std::vector<bool> settled_;
+  size_t raw_next_ = 0, slow_next_ = 0, sweep_next_ = 0;
+  ros::Time start_stamp_;
+  ros::WallTime wall_start_;
+};
+
+}  // namespace cvg_bench

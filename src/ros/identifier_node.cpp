@@ -1,0 +1,406 @@
+// identifier_node (see identifier_node.h).
+#include "cvg_bench/ros/identifier_node.h"
+
+#include <geometry_msgs/TransformStamped.h>
+#include <tf2/LinearMath/Quaternion.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "cvg_bench/DerivedQuantitiesStamped.h"
+#include "cvg_bench/DriftRate.h"
+#include "cvg_bench/ModelEstimate.h"
+#include "cvg_bench/core/derived_uncertainty.h"
+#include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/explanation.h"
+#include "cvg_bench/core/orbit_elements.h"
+#include "cvg_bench/ros/conversions.h"
+
+namespace cvg_bench {
+namespace {
+
+IdentifierNodeOptions loadIdentifierOptions(const ros::NodeHandle& pnh) {
+  ParamReader reader(pnh);
+  return loadOptions<IdentifierNodeOptions>(reader);
+}
+
+ParameterValues valuesOf(const Estimate& e) {
+  ParameterValues v;
+  for (size_t i = 0; i < e.names.size() && static_cast<Eigen::Index>(i) < e.values.size(); ++i)
+    v[e.names[i]] = e.values[i];
+  return v;
+}
+
+geometry_msgs::TransformStamped rotationAboutZ(const std::string& parent, const std::string& child,
+                                               double angle_rad, const ros::Time& stamp) {
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = stamp;
+  t.header.frame_id = parent;
+  t.child_frame_id = child;
+  tf2::Quaternion q;
+  q.setRPY(0.0, 0.0, angle_rad);
+  t.transform.rotation.x = q.x();
+  t.transform.rotation.y = q.y();
+  t.transform.rotation.z = q.z();
+  t.transform.rotation.w = q.w();
+  return t;
+}
+
+std::string summary(const Estimate& e, size_t samples) {
+  std::ostringstream s;
+  s << e.method << " " << e.model << " over " << samples << " samples: " << e.n_equations
+    << " equations, rank " << e.rank << " of " << e.n_params << ", sigma = " << e.sigma;
+  if (!e.unidentifiable.empty()) {
+    s << "; NOT identifiable:";
+    for (const auto& n : e.unidentifiable) s << " " << n;
+    if (!e.identifiability_note.empty()) s << " (" << e.identifiability_note << ")";
+  }
+  return s.str();
+}
+
+}  // namespace
+
+IdentifierNode::IdentifierNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
+    : nh_(nh), options_(loadIdentifierOptions(pnh)), mode_(parseExperimentMode(options_.mode)) {
+  if (options_.identification.method == "rls")
+    rls_.reset(new StreamingFreeDecayRls(options_.identification));
+  estimate_pub_ = nh_.advertise<ModelEstimate>("estimate", 10, /*latch=*/true);
+  derived_pub_ = nh_.advertise<DerivedQuantitiesStamped>("derived", 10, /*latch=*/true);
+  drift_pub_ = nh_.advertise<DriftRate>("drift", 10);
+  if (mode_ == ExperimentMode::kFreeDecay)
+    data_sub_ = nh_.subscribe("slow", options_.queue_size, &IdentifierNode::onSlow, this);
+  else
+    data_sub_ = nh_.subscribe("sweep", options_.queue_size, &IdentifierNode::onSweep, this);
+  identify_srv_ = nh_.advertiseService("identify", &IdentifierNode::onIdentify, this);
+  get_estimate_srv_ = nh_.advertiseService("get_estimate", &IdentifierNode::onGetEstimate, this);
+  predict_drift_srv_ = nh_.advertiseService("predict_drift", &IdentifierNode::onPredictDrift, this);
+  reset_srv_ = nh_.advertiseService("identifier/reset", &IdentifierNode::onReset, this);
+  explain_srv_ = nh_.advertiseService("explain", &IdentifierNode::onExplain, this);
+  timer_ = nh_.createWallTimer(ros::WallDuration(0.05), &IdentifierNode::onTimer, this);
+  ROS_INFO("identifier: %s, model %s, method %s", options_.mode.c_str(),
+           options_.identification.model.c_str(), options_.identification.method.c_str());
+}
+
+double IdentifierNode::omegaForEstimate() const {
+  return options_.identification.omega_rad_s > 0.0 ? options_.identification.omega_rad_s
+                                                   : omega_from_data_rad_s_;
+}
+
+void IdentifierNode::clearData(const std::string& why) {
+  stamps_.clear();
+  slow_q_.clear();
+  sweep_ = SweepRecord();
+  have_latest_ = false;
+  new_data_since_identify_ = false;
+  if (rls_) rls_->reset();
+  rls_origin_ = ros::Time();
+  ROS_WARN("identifier: data cleared: %s", why.c_str());
+}
+
+void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
+  Eigen::Vector4d q;
+  try {
+    q = slowFromMsg(*msg);
+  } catch (const InputError& e) {
+    ++dropped_;
+    ROS_WARN_THROTTLE(5.0, "identifier: slow state dropped (%llu so far): %s",
+                      static_cast<unsigned long long>(dropped_), e.what());
+    return;
+  }
+  const ros::Time stamp = msg->header.stamp;
+  if (have_latest_ && stamp < latest_stamp_)
+    clearData("slow states jumped back in time (bag loop?)");
+  if (have_latest_ && stamp == latest_stamp_) {
+    ++dropped_;
+    ROS_WARN_THROTTLE(5.0, "identifier: duplicate slow-state stamp dropped (%llu so far)",
+                      static_cast<unsigned long long>(dropped_));
+    return;
+  }
+  const double omega = msg->reference_frequency_rad_s - msg->detuning_rad_s;
+  if (omega > 0.0 && std::isfinite(omega)) omega_from_data_rad_s_ = omega;
+  stamps_.push_back(stamp);
+  slow_q_.push_back(q);
+  while (static_cast<int>(stamps_.size()) > options_.max_samples ||
+         (options_.window_s > 0.0 &&
+          secondsSince(stamps_.back(), stamps_.front()) > options_.window_s)) {
+    stamps_.pop_front();
+    slow_q_.pop_front();
+  }
+  latest_q_ = q;
+  latest_stamp_ = stamp;
+  have_latest_ = true;
+  last_data_wall_ = ros::WallTime::now();
+  new_data_since_identify_ = true;
+
+  if (rls_) {
+    if (rls_origin_.isZero()) rls_origin_ = stamp;
+    try {
+      rls_->add(secondsSince(stamp, rls_origin_), q);
+      const ros::WallTime now = ros::WallTime::now();
+      if (rls_->initialized() &&
+          (now - last_rls_publish_wall_).toSec() >= options_.rls_publish_period_s) {
+        estimate_ = rls_->estimate(omegaForEstimate());
+        window_start_ = rls_origin_;
+        window_end_ = stamp;
+        window_samples_ = static_cast<uint32_t>(rls_->numBlocks() + 2);
+        have_estimate_ = true;
+        last_rls_publish_wall_ = now;
+        publishEstimate();
+      }
+    } catch (const std::exception& e) {
+      ROS_WARN_THROTTLE(5.0, "identifier: recursive estimate restarted: %s", e.what());
+      rls_->reset();
+      rls_origin_ = ros::Time();
+    }
+  }
+  publishFrames();
+}
+
+void IdentifierNode::onSweep(const SweepPoint::ConstPtr& msg) {
+  const ros::Time stamp = msg->header.stamp;
+  if (have_latest_ && stamp < latest_stamp_)
+    clearData("sweep points jumped back in time (bag loop?)");
+  try {
+    appendSweepPoint(*msg, &sweep_);
+  } catch (const InputError& e) {
+    ++dropped_;
+    ROS_WARN_THROTTLE(5.0, "identifier: sweep point dropped (%llu so far): %s",
+                      static_cast<unsigned long long>(dropped_), e.what());
+    return;
+  }
+  if (msg->omega_rad_s > 0.0) omega_from_data_rad_s_ = msg->omega_rad_s;
+  stamps_.push_back(stamp);
+  if (static_cast<int>(sweep_.size()) > options_.max_samples) {
+    sweep_.omega0_rad_s.erase(sweep_.omega0_rad_s.begin());
+    sweep_.q.erase(sweep_.q.begin());
+    if (!sweep_.direction.empty()) sweep_.direction.erase(sweep_.direction.begin());
+    if (!sweep_.jump.empty()) sweep_.jump.erase(sweep_.jump.begin());
+    stamps_.pop_front();
+  }
+  latest_q_ = sweep_.q.back();
+  latest_stamp_ = stamp;
+  have_latest_ = true;
+  last_data_wall_ = ros::WallTime::now();
+  new_data_since_identify_ = true;
+  publishFrames();
+}
+
+SlowRecord IdentifierNode::bufferedSlowRecord() const {
+  SlowRecord rec;
+  rec.omega_rad_s = omega_from_data_rad_s_;
+  rec.source = "identifier buffer";
+  rec.t_s.reserve(stamps_.size());
+  for (size_t i = 0; i < stamps_.size(); ++i) {
+    rec.t_s.push_back(secondsSince(stamps_[i], stamps_.front()));
+    rec.q.push_back(slow_q_[i]);
+  }
+  return rec;
+}
+
+void IdentifierNode::identifyNow(const IdentificationOptions& options) {
+  const int have = static_cast<int>(stamps_.size());
+  if (have < options_.min_samples)
+    throw InputError("only " + std::to_string(have) +
+                     (mode_ == ExperimentMode::kFreeDecay ? " slow states" : " sweep points") +
+                     " buffered; min_samples is " + std::to_string(options_.min_samples));
+  Estimate e = mode_ == ExperimentMode::kFreeDecay
+                   ? identifyFreeDecay(bufferedSlowRecord(), options)
+                   : identifyForced(sweep_, options);
+  estimate_ = e;
+  window_start_ = stamps_.front();
+  window_end_ = stamps_.back();
+  window_samples_ = static_cast<uint32_t>(have);
+  have_estimate_ = true;
+  new_data_since_identify_ = false;
+  if (e.rank < e.n_params)
+    ROS_WARN("identifier: %s", summary(e, have).c_str());
+  else
+    ROS_INFO("identifier: %s", summary(e, have).c_str());
+  publishEstimate();
+}
+
+void IdentifierNode::onTimer(const ros::WallTimerEvent&) {
+  const ros::WallTime now = ros::WallTime::now();
+  bool run = false;
+  if (options_.identify_period_s > 0.0 && new_data_since_identify_ &&
+      (now - last_periodic_wall_).toSec() >= options_.identify_period_s) {
+    run = true;
+    last_periodic_wall_ = now;
+  }
+  if (options_.idle_identify_s > 0.0 && new_data_since_identify_ &&
+      (now - last_data_wall_).toSec() >= options_.idle_identify_s)
+    run = true;
+  if (!run) return;
+  new_data_since_identify_ = false;  // one attempt per batch of new data
+  try {
+    identifyNow(options_.identification);
+  } catch (const std::exception& e) {
+    ROS_WARN("identifier: identification failed: %s", e.what());
+  }
+}
+
+void IdentifierNode::publishEstimate() {
+  ModelEstimate msg = estimateToMsg(estimate_, window_start_, window_end_, window_samples_);
+  msg.header.frame_id = options_.frame_id;
+  estimate_pub_.publish(msg);
+  if (!estimate_.derived.empty()) {
+    DerivedQuantitiesStamped d = derivedToMsg(estimate_.derived, window_end_, estimate_.confidence,
+                                              options_.identification.angular_gain_k);
+    d.header.frame_id = options_.frame_id;
+    derived_pub_.publish(d);
+  }
+  if (have_latest_) {
+    const OrbitElements o = orbitFromSlow(latest_q_);
+    if (std::fabs(o.r * o.r - o.k * o.k) > 1e-12 * (o.r * o.r + 1e-300)) {
+      try {
+        const ParameterEstimate rate =
+            driftRateWithInterval(o.r, o.k, o.theta, uncertainParameters(estimate_));
+        DriftRate d = driftRateToMsg(o.r, o.k, o.theta, rate, estimate_.confidence, latest_stamp_);
+        d.header.frame_id = options_.frame_id;
+        drift_pub_.publish(d);
+      } catch (const std::exception& e) {
+        ROS_WARN_THROTTLE(5.0, "identifier: no drift rate: %s", e.what());
+      }
+    }
+  }
+  publishFrames();
+}
+
+void IdentifierNode::publishFrames() {
+  if (!have_estimate_ && !have_latest_) return;
+  const ros::Time stamp = have_latest_ ? latest_stamp_ : window_end_;
+  const ros::WallTime now = ros::WallTime::now();
+  // tf2 rejects repeated stamps; 20 Hz is plenty for rviz.
+  if (stamp == last_tf_stamp_ || (now - last_tf_wall_).toSec() < 0.05) return;
+  last_tf_stamp_ = stamp;
+  last_tf_wall_ = now;
+  std::vector<geometry_msgs::TransformStamped> frames;
+  const std::string& parent = options_.frame_id;
+  const std::string& prefix = options_.child_frame_prefix;
+  if (have_estimate_) {
+    const DefectAxes axes = defectAxes(valuesOf(estimate_));
+    frames.push_back(rotationAboutZ(parent, prefix + "stiffness_axis", axes.alpha, stamp));
+    frames.push_back(rotationAboutZ(parent, prefix + "damping_axis", axes.beta, stamp));
+  }
+  if (have_latest_)
+    frames.push_back(
+        rotationAboutZ(parent, prefix + "wave_pattern", orbitFromSlow(latest_q_).theta, stamp));
+  tf_.sendTransform(frames);
+}
+
+bool IdentifierNode::onIdentify(Identify::Request& req, Identify::Response& res) {
+  IdentificationOptions o = options_.identification;
+  if (!req.model.empty()) o.model = req.model;
+  if (!req.method.empty()) o.method = req.method;
+  if (req.confidence != 0.0) o.confidence = req.confidence;
+  try {
+    throwIfProblems("identify request", o.validate());
+    identifyNow(o);
+    res.success = estimate_.rank == estimate_.n_params;
+    res.message = summary(estimate_, window_samples_);
+    res.estimate = estimateToMsg(estimate_, window_start_, window_end_, window_samples_);
+    res.estimate.header.frame_id = options_.frame_id;
+    res.derived =
+        derivedToMsg(estimate_.derived, window_end_, estimate_.confidence, o.angular_gain_k);
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+bool IdentifierNode::onGetEstimate(GetEstimate::Request&, GetEstimate::Response& res) {
+  if (!have_estimate_) {
+    res.success = false;
+    res.message = "no estimate yet (" + std::to_string(stamps_.size()) + " samples buffered)";
+    return true;
+  }
+  res.success = estimate_.rank == estimate_.n_params;
+  res.message = summary(estimate_, window_samples_);
+  res.estimate = estimateToMsg(estimate_, window_start_, window_end_, window_samples_);
+  res.estimate.header.frame_id = options_.frame_id;
+  res.derived = derivedToMsg(estimate_.derived, window_end_, estimate_.confidence,
+                             options_.identification.angular_gain_k);
+  return true;
+}
+
+bool IdentifierNode::onPredictDrift(PredictDrift::Request& req, PredictDrift::Response& res) {
+  try {
+    if (!have_estimate_) throw InputError("no estimate yet: call identify first");
+    double r = req.r, k = req.k, theta = req.theta_rad;
+    if (r == 0.0) {
+      if (!have_latest_)
+        throw InputError("r = 0 asks for the latest slow state, and there is none");
+      const OrbitElements o = orbitFromSlow(latest_q_);
+      r = o.r;
+      k = o.k;
+      if (req.theta_grid == 0) theta = o.theta;
+    }
+    requireFinite(r, "r");
+    requireFinite(k, "k");
+    requireFinite(theta, "theta_rad");
+    if (!(std::fabs(r) > std::fabs(k)))
+      throw InputError("need |r| > |k| (a standing-wave component): (5.9) is singular at r = |k|");
+    if (req.theta_grid > 100000) throw InputError("theta_grid: at most 100000 angles");
+    std::vector<double> thetas;
+    if (req.theta_grid == 0)
+      thetas.push_back(theta);
+    else
+      for (uint32_t i = 0; i < req.theta_grid; ++i) thetas.push_back(M_PI / 2 * i / req.theta_grid);
+    const UncertainParameters p = uncertainParameters(estimate_);
+    const ros::Time stamp = ros::Time::now();
+    for (double th : thetas)
+      res.rates.push_back(driftRateToMsg(r, k, th, driftRateWithInterval(r, k, th, p),
+                                         estimate_.confidence, stamp));
+    res.success = true;
+    res.message = std::to_string(res.rates.size()) + " drift rate(s) by (5.9) from the " +
+                  estimate_.method + " estimate of " + estimate_.model;
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = e.what();
+    res.rates.clear();
+  }
+  return true;
+}
+
+bool IdentifierNode::onReset(Reset::Request&, Reset::Response& res) {
+  clearData("reset requested");
+  have_estimate_ = false;
+  estimate_ = Estimate();
+  res.success = true;
+  res.message = "identifier reset: buffer and estimates cleared";
+  return true;
+}
+
+bool IdentifierNode::onExplain(Explain::Request& req, Explain::Response& res) {
+  try {
+    const ExperimentMode mode = req.mode.empty() ? mode_ : parseExperimentMode(req.mode);
+    if (mode != mode_)
+      throw InputError("this identifier buffers " + experimentModeName(mode_) + " data, not " +
+                       experimentModeName(mode));
+    ExplainOptions eo;
+    eo.fitting.identification = options_.identification;
+    if (eo.fitting.identification.method == "rls") eo.fitting.identification.method = "ls";
+    const int have = static_cast<int>(stamps_.size());
+    if (have < options_.min_samples)
+      throw InputError("only " + std::to_string(have) + " samples buffered; min_samples is " +
+                       std::to_string(options_.min_samples));
+    const Explanation ex = mode_ == ExperimentMode::kFreeDecay
+                               ? explainFreeDecay(bufferedSlowRecord(), eo)
+                               : explainForced(sweep_, eo);
+    std::string selected;
+    for (const auto& s : ex.selection.selected) selected += (selected.empty() ? "" : "+") + s;
+    res.success = true;
+    res.message = ex.cause + " [selected: " + (selected.empty() ? "none" : selected) +
+                  (ex.unexplained ? "; structure remains unexplained" : "") + "]";
+    // The JSON of `cvg_ident explain` is written by the tool (src/tools/explain_json.cpp); until it
+    // is shared with the nodes, report_json stays empty.
+    res.report_json = "";
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = e.what();
+  }
+  return true;
+}
+
+}  // namespace cvg_bench

@@ -1,0 +1,219 @@
+// resonator_simulator_node (see simulator_node.h).
+#include "cvg_bench/ros/simulator_node.h"
+
+#include <algorithm>
+
+#include "cvg_bench/RawSampleBatch.h"
+#include "cvg_bench/SimulationTruth.h"
+#include "cvg_bench/SlowState.h"
+#include "cvg_bench/SweepPoint.h"
+#include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/experiment_runner.h"
+#include "cvg_bench/core/measurement_noise.h"
+#include "cvg_bench/ros/conversions.h"
+
+namespace cvg_bench {
+namespace {
+
+ResonatorPreset loadPreset(const SimulatorNodeOptions& o) {
+  ResonatorPreset p =
+      o.config.empty() ? loadShippedPreset(o.preset) : loadResonatorPresetFile(o.config);
+  p.noise_q_std *= o.noise_scale;
+  p.noise_fg_std *= o.noise_scale;
+  return p;
+}
+
+SimulatorNodeOptions loadSimulatorOptions(const ros::NodeHandle& pnh) {
+  ParamReader reader(pnh);
+  return loadOptions<SimulatorNodeOptions>(reader);
+}
+
+}  // namespace
+
+SimulatorNode::SimulatorNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh)
+    : nh_(nh), options_(loadSimulatorOptions(pnh)), preset_(loadPreset(options_)) {
+  raw_pub_ = nh_.advertise<RawSampleBatch>("raw", 100);
+  slow_pub_ = nh_.advertise<SlowState>("sim/slow", 10000);
+  slow_truth_pub_ = nh_.advertise<SlowState>("sim/slow_truth", 10000);
+  sweep_pub_ = nh_.advertise<SweepPoint>("sweep", 1000);
+  truth_pub_ = nh_.advertise<SimulationTruth>("truth", 1, /*latch=*/true);
+  start_free_decay_srv_ =
+      nh_.advertiseService("start_free_decay", &SimulatorNode::onStartFreeDecay, this);
+  start_sweep_srv_ = nh_.advertiseService("start_sweep", &SimulatorNode::onStartSweep, this);
+  timer_ = nh_.createWallTimer(ros::WallDuration(1.0 / options_.publish_rate_hz),
+                               &SimulatorNode::onTick, this);
+  ROS_INFO("resonator simulator: preset '%s' (%s), omega = %.6g rad/s", preset_.name.c_str(),
+           preset_.description.c_str(), preset_.omega_rad_s);
+  if (options_.autostart == "free_decay") startFreeDecay(0.0, options_.seed);
+  if (options_.autostart == "forced") startSweep(preset_, options_.seed);
+}
+
+bool SimulatorNode::onStartFreeDecay(StartFreeDecay::Request& req, StartFreeDecay::Response& res) {
+  try {
+    startFreeDecay(req.duration_s, req.seed > 0 ? static_cast<int>(req.seed) : options_.seed);
+    res.success = true;
+    res.message = "free decay started: " + std::to_string(raw_.size()) + " raw samples, " +
+                  std::to_string(slow_.size()) + " slow states";
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = e.what();
+    ROS_ERROR("start_free_decay refused: %s", e.what());
+  }
+  return true;
+}
+
+bool SimulatorNode::onStartSweep(StartSweep::Request& req, StartSweep::Response& res) {
+  try {
+    ResonatorPreset p = preset_;
+    if (req.omega0_start_rad_s > 0.0)
+      p.sweep_lambda_min_rad_s = req.omega0_start_rad_s - p.omega_rad_s;
+    if (req.omega0_end_rad_s > 0.0) p.sweep_lambda_max_rad_s = req.omega0_end_rad_s - p.omega_rad_s;
+    if (req.n_points > 0) p.sweep_points = static_cast<int>(req.n_points);
+    p.sweep_down = p.sweep_down || req.up_and_down;
+    throwIfProblems("sweep request", p.validate());
+    startSweep(p, req.seed > 0 ? static_cast<int>(req.seed) : options_.seed);
+    res.success = true;
+    res.message = "sweep started: " + std::to_string(sweep_.size()) + " points";
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = e.what();
+    ROS_ERROR("start_sweep refused: %s", e.what());
+  }
+  return true;
+}
+
+void SimulatorNode::startFreeDecay(double duration_s, int seed) {
+  requireFinite(duration_s, "duration_s");
+  if (duration_s < 0.0) throw InputError("duration_s must be >= 0");
+  running_ = Running::kNone;
+  const double duration = duration_s > 0.0 ? duration_s : options_.duration_s;
+  SimulationOptions sim;
+  sim.mode = ExperimentMode::kFreeDecay;
+  sim.seed = static_cast<std::uint64_t>(seed);
+  raw_ = RawRecord();
+  slow_ = SlowRecord();
+  slow_truth_ = SlowRecord();
+  sweep_ = SweepRecord();
+  if (options_.publish_raw) {
+    sim.raw = true;
+    sim.duration_s = duration;
+    raw_ = simulateExperiment(preset_, sim).raw;
+  }
+  if (options_.publish_slow) {
+    sim.raw = false;
+    // The slow record covers the raw record's span when both are published.
+    sim.duration_s =
+        duration > 0.0 ? duration : (options_.publish_raw ? preset_.decay_raw_duration_s : 0.0);
+    slow_ = simulateExperiment(preset_, sim).slow;
+    sim.noise_std = 0.0;
+    slow_truth_ = simulateExperiment(preset_, sim).slow;
+  }
+  beginStreaming(Running::kFreeDecay, ExperimentMode::kFreeDecay, preset_);
+  ROS_INFO("free decay started (seed %d): %zu raw samples, %zu slow states", seed, raw_.size(),
+           slow_.size());
+}
+
+void SimulatorNode::startSweep(const ResonatorPreset& preset, int seed) {
+  running_ = Running::kNone;
+  const ExperimentRunner runner(preset);
+  const SweepResult result = runner.forcedSweep();
+  raw_ = RawRecord();
+  slow_ = SlowRecord();
+  slow_truth_ = SlowRecord();
+  sweep_ = SweepRecord();
+  settled_.clear();
+  sweep_.omega_rad_s = preset.omega_rad_s;
+  for (const SweepStep& s : result.steps) {
+    sweep_.omega0_rad_s.push_back(s.omega0_rad_s);
+    sweep_.q.push_back(s.q);
+    sweep_.direction.push_back(s.direction);
+    sweep_.jump.push_back(s.jump ? 1 : 0);
+    settled_.push_back(s.settled);
+  }
+  MeasurementNoise noise(static_cast<std::uint64_t>(seed));
+  noise.addTo(sweep_, preset.noise_q_std);
+  beginStreaming(Running::kSweep, ExperimentMode::kForced, preset);
+  ROS_INFO("forced sweep started (seed %d): %zu points, %d jumps, %d unsettled", seed,
+           sweep_.size(), result.n_jumps, result.n_unsettled);
+}
+
+void SimulatorNode::beginStreaming(Running what, ExperimentMode mode,
+                                   const ResonatorPreset& preset) {
+  raw_next_ = slow_next_ = sweep_next_ = 0;
+  start_stamp_ = ros::Time::now() + ros::Duration(options_.start_delay_s);
+  wall_start_ = ros::WallTime::now() + ros::WallDuration(options_.start_delay_s);
+  running_ = what;
+  const std::string spec = preset.truthModelSpec(mode);
+  const ResonatorModel model(spec, mode);
+  const Eigen::VectorXd z = preset.truthParameters(model);
+  SimulationTruth truth =
+      truthToMsg(options_.config.empty() ? preset.name : options_.config, experimentModeName(mode),
+                 spec, preset.omega_rad_s, preset.mu, model.parameterNames(),
+                 model.parameterValues(z), start_stamp_);
+  truth.header.frame_id = options_.frame_id;
+  truth.raw_noise_std = preset.noise_fg_std;
+  truth.slow_noise_std = preset.noise_q_std;
+  truth.raw_sample_rate_hz = preset.raw_sample_rate_hz;
+  truth.n_raw_samples = static_cast<uint32_t>(raw_.size());
+  truth.n_slow_states = static_cast<uint32_t>(slow_.size());
+  truth.n_sweep_points = static_cast<uint32_t>(what == Running::kSweep ? sweep_.size() : 0);
+  if (what == Running::kFreeDecay)
+    truth.duration_s =
+        std::max(raw_.size() ? raw_.t_s.back() : 0.0, slow_.size() ? slow_.t_s.back() : 0.0);
+  truth_pub_.publish(truth);
+}
+
+void SimulatorNode::onTick(const ros::WallTimerEvent&) {
+  if (running_ == Running::kNone) return;
+  const double wall_elapsed = (ros::WallTime::now() - wall_start_).toSec();
+  if (wall_elapsed < 0.0) return;
+  if (running_ == Running::kFreeDecay) publishDueFreeDecay(wall_elapsed * options_.realtime_factor);
+  if (running_ == Running::kSweep) publishDueSweep(wall_elapsed);
+}
+
+void SimulatorNode::publishDueFreeDecay(double due_s) {
+  if (raw_next_ < raw_.size()) {
+    size_t end = raw_next_;
+    while (end < raw_.size() && raw_.t_s[end] <= due_s) ++end;
+    if (end > raw_next_) {
+      RawSampleBatch batch =
+          rawBatchToMsg(raw_, raw_next_, end, start_stamp_, preset_.raw_sample_rate_hz);
+      batch.header.frame_id = options_.frame_id;
+      batch.omega_rad_s = preset_.omega_rad_s;
+      raw_pub_.publish(batch);
+      raw_next_ = end;
+    }
+  }
+  for (; slow_next_ < slow_.size() && slow_.t_s[slow_next_] <= due_s; ++slow_next_) {
+    const ros::Time stamp = timeAfter(start_stamp_, slow_.t_s[slow_next_]);
+    SlowState s = slowStateToMsg(slow_.q[slow_next_], stamp, start_stamp_, preset_.omega_rad_s);
+    s.header.frame_id = options_.frame_id;
+    slow_pub_.publish(s);
+    if (slow_next_ < slow_truth_.size()) {
+      SlowState t =
+          slowStateToMsg(slow_truth_.q[slow_next_], stamp, start_stamp_, preset_.omega_rad_s);
+      t.header.frame_id = options_.frame_id;
+      slow_truth_pub_.publish(t);
+    }
+  }
+  if (raw_next_ >= raw_.size() && slow_next_ >= slow_.size()) {
+    running_ = Running::kNone;
+    ROS_INFO("free decay finished (%.6g s simulated)", due_s);
+  }
+}
+
+void SimulatorNode::publishDueSweep(double wall_elapsed_s) {
+  const double interval = std::max(options_.sweep_point_interval_s, 1e-9);
+  for (; sweep_next_ < sweep_.size() && sweep_next_ * interval <= wall_elapsed_s; ++sweep_next_) {
+    SweepPoint p = sweepPointToMsg(sweep_, sweep_next_, ros::Time::now());
+    p.settled = settled_[sweep_next_];
+    p.header.frame_id = options_.frame_id;
+    sweep_pub_.publish(p);
+  }
+  if (sweep_next_ >= sweep_.size()) {
+    running_ = Running::kNone;
+    ROS_INFO("forced sweep finished (%zu points)", sweep_.size());
+  }
+}
+
+}  // namespace cvg_bench
