@@ -65,10 +65,8 @@ TEST(HiddenEffect, FreeDecayFindsTheDrawnEffect) {
 }
 
 // Frequency drift during the record: identify (LS) finds cm_rate = 217 +/- 19 at truth 200 on
-// mems_ring (seed 7), so 100 is ~5 standard errors. DISABLED while the output-error refinement
-// returns the scaled parameters for this model (refineWithCeres gives cm_rate ~1, c_m ~1 on this
-// record: ceres_refinement.cpp, owned by the CERES helper); enable when it passes.
-TEST(HiddenEffect, DISABLED_FreeDecayFindsFrequencyDrift) {
+// mems_ring (seed 7), so 100 is ~5 standard errors.
+TEST(HiddenEffect, FreeDecayFindsFrequencyDrift) {
   const HiddenEffect e{"cm_rate", 100.0};
   const AnyRecord rec = simulate(ExperimentMode::kFreeDecay, {e}, 22);
   const Explanation x = explainFreeDecay(rec.slow, ExplainOptions());
