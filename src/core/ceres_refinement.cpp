@@ -164,13 +164,22 @@ void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estima
   ceres::Covariance covariance(co);
   std::vector<const double*> cblocks(fp.blocks.begin(), fp.blocks.end());
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> cov(p, p);
-  if (!covariance.Compute(cblocks, fp.problem) ||
-      !covariance.GetCovarianceMatrix(cblocks, cov.data()))
-    throw AnalysisError(
-        "Ceres refinement: covariance could not be computed (Jacobian too ill-conditioned for "
-        "min_reciprocal_condition_number)");
-  const Eigen::MatrixXd full_cov =
-      sigma2 * scale.asDiagonal() * Eigen::MatrixXd(cov) * scale.asDiagonal();
+  Eigen::MatrixXd unscaled_cov;  // (J'J)^+ in the unscaled unknowns
+  if (covariance.Compute(cblocks, fp.problem) &&
+      covariance.GetCovarianceMatrix(cblocks, cov.data())) {
+    unscaled_cov = scale.asDiagonal() * Eigen::MatrixXd(cov) * scale.asDiagonal();
+  } else {
+    // ceres::Covariance refused (its condition test runs on the unequilibrated J'J): the same
+    // pseudo-inverse from the SVD of the column-equilibrated Jacobian, truncated at the rank.
+    const Eigen::MatrixXd v = svd.matrixV().leftCols(rank);
+    const Eigen::VectorXd inv_s2 = s.head(rank).cwiseAbs2().cwiseInverse();
+    unscaled_cov = norms.cwiseInverse().asDiagonal() * v * inv_s2.asDiagonal() * v.transpose() *
+                   norms.cwiseInverse().asDiagonal();
+    e->notes.push_back(
+        "covariance from the SVD of the column-equilibrated Jacobian (ceres::Covariance judged "
+        "J'J too ill-conditioned before equilibration)");
+  }
+  const Eigen::MatrixXd full_cov = sigma2 * unscaled_cov;
 
   Eigen::VectorXd x(p);
   for (size_t b = 0, o = 0; b < fp.blocks.size(); o += fp.block_sizes[b], ++b)
