@@ -109,6 +109,17 @@ void printTable(const Estimate& e, std::ostream& os) {
   for (const auto& n : e.notes) os << "note: " << n << "\n";
 }
 
+/// Ceres options from the identify options: same confidence and angular gain; --mu is the known mu,
+/// or the starting value when the model estimates mu.
+CeresOptions ceresOptionsFor(const IdentificationOptions& opt) {
+  CeresOptions co;
+  co.confidence = opt.confidence;
+  co.angular_gain_k = opt.angular_gain_k;
+  co.known_mu = opt.mu;
+  co.mu_start = opt.mu;
+  return co;
+}
+
 }  // namespace
 
 int runIdentify(const std::vector<std::string>& argv) {
@@ -155,11 +166,7 @@ int runIdentify(const std::vector<std::string>& argv) {
                          : any.slow;
     if (rec.source.empty()) rec.source = path;
     e = identifyFreeDecay(rec, opt);
-    if (method == "ceres") {
-      CeresOptions co;
-      co.confidence = opt.confidence;
-      e = refineWithCeres(rec, e, co);
-    }
+    if (method == "ceres") e = refineWithCeres(rec, e, ceresOptionsFor(opt));
   } else {
     if (any.kind == RecordKind::kFreeDecay)
       throw InputError(path +
@@ -187,12 +194,7 @@ int runIdentify(const std::vector<std::string>& argv) {
     } else {
       e = identifyForced(rec, opt);
     }
-    if (method == "ceres") {
-      CeresOptions co;
-      co.confidence = opt.confidence;
-      co.known_mu = opt.mu;
-      e = refineWithCeres(rec, e, co);
-    }
+    if (method == "ceres") e = refineWithCeres(rec, e, ceresOptionsFor(opt));
   }
   e.notes.insert(e.notes.begin(), pre_notes.begin(), pre_notes.end());
   std::cout << std::setprecision(8);

@@ -1,4 +1,6 @@
 // cvg_ident: the offline tool over the cvg_bench core (no roscore). See interfaces.md.
+#include <glog/logging.h>
+
 #include <iostream>
 #include <map>
 
@@ -22,9 +24,15 @@ const char* kUsage =
 
 int main(int argc, char** argv) {
   using namespace cvg_bench::tools;
+  // Ceres logs failed evaluations through glog; the tool reports outcomes itself (notes, exit
+  // codes).
+  FLAGS_minloglevel = google::GLOG_ERROR;
   const std::map<std::string, int (*)(const std::vector<std::string>&)> commands = {
-      {"simulate", runSimulate}, {"demod", runDemod},     {"identify", runIdentify},
-      {"drift", runDrift},       {"explain", runExplain}};
+      {"simulate", runSimulate},
+      {"demod", runDemod},
+      {"identify", runIdentify},
+      {"drift", runDrift},
+      {"explain", runExplain}};
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     std::cout << kUsage;
     return argc < 2 ? 2 : 0;
