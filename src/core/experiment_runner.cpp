@@ -1,6 +1,5 @@
 #include "cvg_bench/core/experiment_runner.h"
 
-#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +8,7 @@
 #include "cvg_bench/core/fast_simulator.h"
 #include "cvg_bench/core/measurement_noise.h"
 #include "cvg_bench/core/slow_simulator.h"
+#include "cvg_bench/core/stationary_solver.h"
 
 namespace cvg_bench {
 namespace {
@@ -35,10 +35,6 @@ struct ForcedSystem {
         amplitude_scale(std::max(p.drive_u_tilde.norm() / gamma, 1e-12)) {}
 
   double rate(double lambda) const { return detuningRate(omega, omega + lambda); }
-  /// F(q) = 2 q' = D(q) z - rate y(q) of (3.3).
-  Eigen::Vector4d residual(const Eigen::Vector4d& q, double rate) const {
-    return 2.0 * model.slowDerivative(q, SlowContext{0.0, mu}, z, rate);
-  }
 };
 
 struct NewtonResult {
@@ -46,34 +42,19 @@ struct NewtonResult {
   bool converged = false;
 };
 
-/// Damped Newton on F(q) = 0 with a central-difference Jacobian of the model's own F.
+/// Damped Newton on F(q) = 0 (the shared stationary solver), scaled to the drive's amplitude.
 NewtonResult solveStationary(const ForcedSystem& sys, double rate, const Eigen::Vector4d& start) {
+  StationarySolverOptions o;
+  o.max_iterations = 40;
+  o.step_tolerance = 1e-12;
+  o.q_scale = sys.amplitude_scale;
+  o.difference_step = 1e-7;
+  o.min_reciprocal_condition = 1e-13;
+  const StationaryPoint p =
+      solveStationaryPoint(sys.model, sys.z, SlowContext{0.0, sys.mu}, rate, start, o);
   NewtonResult r;
-  Eigen::Vector4d q = start;
-  const double scale = sys.amplitude_scale;
-  for (int it = 0; it < 40; ++it) {
-    const Eigen::Vector4d f = sys.residual(q, rate);
-    Eigen::Matrix4d jac;
-    const double h = 1e-7 * std::max(q.cwiseAbs().maxCoeff(), scale);
-    for (int i = 0; i < 4; ++i) {
-      Eigen::Vector4d e = Eigen::Vector4d::Zero();
-      e[i] = h;
-      jac.col(i) = (sys.residual(q + e, rate) - sys.residual(q - e, rate)) / (2.0 * h);
-    }
-    const Eigen::FullPivLU<Eigen::Matrix4d> lu(jac);
-    if (!(lu.rcond() > 1e-13)) break;  // singular: at a fold
-    const Eigen::Vector4d dq = -lu.solve(f);
-    double step = 1.0;
-    const double f_norm = f.norm();
-    while (step > 1.0 / 64 && sys.residual(q + step * dq, rate).norm() > f_norm) step *= 0.5;
-    q += step * dq;
-    if (!q.allFinite()) break;
-    if ((step * dq).norm() <= 1e-12 * std::max(q.norm(), scale)) {
-      r.converged = true;
-      break;
-    }
-  }
-  r.q = q;
+  r.q = p.q;
+  r.converged = p.converged && p.q.allFinite();
   return r;
 }
 
