@@ -80,7 +80,7 @@ IdentifiabilityReport analyzeIdentifiability(const std::vector<std::string>& nam
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(ns_s, Eigen::ComputeFullU);
   int r = 0;
   for (int i = 0; i < svd.singularValues().size(); ++i)
-    if (svd.singularValues()[i] > 1e-9) ++r;
+    if (svd.singularValues()[i] > coefficient_tolerance) ++r;
   const int nc = p - r;
   if (nc > 0) {
     // Rows: combinations in parameter units (c_z = c_w .* scale), then reduced row-echelon form.
@@ -90,7 +90,7 @@ IdentifiabilityReport analyzeIdentifiability(const std::vector<std::string>& nam
     for (int col = 0; col < p && row < nc; ++col) {
       Eigen::Index piv;
       const double best = comb.col(col).segment(row, nc - row).cwiseAbs().maxCoeff(&piv);
-      if (best <= 1e-9 * comb.cwiseAbs().maxCoeff()) continue;
+      if (best <= coefficient_tolerance * comb.cwiseAbs().maxCoeff()) continue;
       comb.row(row).swap(comb.row(row + piv));
       comb.row(row) /= comb(row, col);
       for (int i = 0; i < nc; ++i)
@@ -103,7 +103,7 @@ IdentifiabilityReport analyzeIdentifiability(const std::vector<std::string>& nam
       bool first = true;
       for (int j = 0; j < p; ++j) {
         const double v = comb(i, j);
-        if (std::fabs(v) < 1e-9) continue;
+        if (std::fabs(v) < coefficient_tolerance) continue;
         c.coefficients[involved[j]] = v;
         c.name += coefficientText(v, first) + names[involved[j]];
         first = false;
