@@ -33,6 +33,29 @@ struct SystemInfo {
   const ResonatorModel* resonator = nullptr;
 };
 
+/// ExcitationSummary of the centre samples, accumulated in squares (no square roots per sample).
+struct SquaredExcitation {
+  double max_sq = 0.0, min_sq = 0.0, max_mode1_sq = 0.0, max_mode2_sq = 0.0;
+  long count = 0;
+  void add(const Eigen::Vector4d& q) {
+    const double m1 = q[0] * q[0] + q[1] * q[1], m2 = q[2] * q[2] + q[3] * q[3], a = m1 + m2;
+    max_sq = count == 0 ? a : std::max(max_sq, a);
+    min_sq = count == 0 ? a : std::min(min_sq, a);
+    max_mode1_sq = std::max(max_mode1_sq, m1);
+    max_mode2_sq = std::max(max_mode2_sq, m2);
+    ++count;
+  }
+  ExcitationSummary summary() const {
+    ExcitationSummary s;
+    s.max_amplitude = std::sqrt(max_sq);
+    s.min_amplitude = std::sqrt(min_sq);
+    s.max_mode1 = std::sqrt(max_mode1_sq);
+    s.max_mode2 = std::sqrt(max_mode2_sq);
+    s.num_points = count;
+    return s;
+  }
+};
+
 std::string fmt(double v) {
   std::ostringstream s;
   s.precision(6);
@@ -63,7 +86,7 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
   const bool rls = opt.method == "rls";
   // ---- pass 1: QR of the whole system (and RLS over the same blocks)
   IncrementalQr qr(k);
-  ExcitationSummary excitation;
+  SquaredExcitation excitation;
   const int m_init = opt.rls_init_blocks > 0 ? opt.rls_init_blocks : std::max(2 * k, 8);
   IncrementalQr qr_init(k);
   BlockRecursiveLeastSquares filter(k, opt.rls_forgetting);
@@ -147,11 +170,16 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
     struct SampleTerms {
       RegressionBlockMatrix u, v;
       double s2 = 0.0, sw = 0.0, w2 = 0.0;  // sums of s^2, s w, w^2 over the sample's blocks
+      void clear() {
+        u.setZero();
+        v.setZero();
+        s2 = sw = w2 = 0.0;
+      }
     };
     SampleTerms acc[3];
     for (auto& a : acc) {
-      a.u.setZero(4, k);
-      a.v.setZero(4, k);
+      a.u.resize(4, k);
+      a.v.resize(4, k);
     }
     constexpr int kBatch = 64;
     Eigen::MatrixXd wbuf(k, 4 * kBatch), meat = Eigen::MatrixXd::Zero(k, k);
@@ -171,9 +199,6 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
         in_buf = 0;
       }
       tr_a += 4.0 * a.s2 - 2.0 * a.sw * g.trace() + a.w2 * g.squaredNorm();
-      a.u.setZero();
-      a.v.setZero();
-      a.s2 = a.sw = a.w2 = 0.0;
     };
     Eigen::Vector4d r_hist[2] = {Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
     long in_record = 0;
@@ -188,18 +213,22 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
       SampleTerms& prev = acc[in_record % 3];
       SampleTerms& mid = acc[(in_record + 1) % 3];
       SampleTerms& next = acc[(in_record + 2) % 3];
-      prev.u.noalias() -= 2.0 * d;
-      prev.v.noalias() += b.weights[0] * d;
+      if (in_record == 0) {  // samples 0 and 1 of the record start here
+        prev.clear();
+        mid.clear();
+      }
+      prev.u -= 2.0 * d;
+      prev.v += b.weights[0] * d;
       prev.s2 += 4.0;
       prev.sw -= 2.0 * b.weights[0];
       prev.w2 += b.weights[0] * b.weights[0];
-      mid.v.noalias() += b.weights[1] * d;
+      mid.v += b.weights[1] * d;
       mid.w2 += b.weights[1] * b.weights[1];
-      next.u.noalias() += 2.0 * d;
-      next.v.noalias() += b.weights[2] * d;
-      next.s2 += 4.0;
-      next.sw += 2.0 * b.weights[2];
-      next.w2 += b.weights[2] * b.weights[2];
+      next.u = 2.0 * d;  // sample i+1 appears first here
+      next.v = b.weights[2] * d;
+      next.s2 = 4.0;
+      next.sw = 2.0 * b.weights[2];
+      next.w2 = b.weights[2] * b.weights[2];
       finish(prev, b.q_prev, b.t_prev);  // sample i-1 appears in no later block
       ++in_record;
       if (b.last_in_record) {
@@ -221,13 +250,21 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
                       " (white noise on q predicts -0.5)");
   } else {
     // Sweep points are independent: per-point (cluster) sandwich from the residuals.
-    Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(k, k);
+    // sum of sc sc' with sc = D_j' r_j, folded in 64 points at a time (symmetric rank update).
+    constexpr int kBatch = 64;
+    Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(k, k), scores(k, kBatch);
+    int in_buf = 0;
     stream([&](int, const RegressionBlock& b) {
       const Eigen::Vector4d r = b.y - (*b.d) * z;
       rss += r.squaredNorm();
-      const Eigen::VectorXd sc = b.d->transpose() * r;
-      meat.noalias() += sc * sc.transpose();
+      scores.col(in_buf).noalias() = b.d->transpose() * r;
+      if (++in_buf == kBatch) {
+        meat.selfadjointView<Eigen::Lower>().rankUpdate(scores);
+        in_buf = 0;
+      }
     });
+    if (in_buf > 0) meat.selfadjointView<Eigen::Lower>().rankUpdate(scores.leftCols(in_buf));
+    meat.triangularView<Eigen::StrictlyUpper>() = meat.transpose();
     const double g = static_cast<double>(std::max(2L, info.num_clusters));
     const double factor = g / (g - 1.0) * static_cast<double>(n - 1) / dof_paper;
     honest = factor * c * meat * c;
@@ -262,7 +299,7 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
 
   // ---- identifiability
   const IdentifiabilityReport idr =
-      analyzeIdentifiability(info.names, ls.null_space, ls.column_norms, excitation);
+      analyzeIdentifiability(info.names, ls.null_space, ls.column_norms, excitation.summary());
   e.unidentifiable = idr.unidentifiable;
   e.identifiability_note = idr.note;
   for (int j = 0; j < k; ++j) {

@@ -101,12 +101,14 @@ void ResonatorModel::regressorJacobian(const Eigen::Vector4d& q, const SlowConte
   if (z.size() != numParameters())
     throw InputError("regressor Jacobian: " + std::to_string(z.size()) + " values for " +
                      std::to_string(numParameters()) + " parameters of model " + spec());
-  jacobian.setZero();
-  Eigen::Matrix4d term_jacobian;
-  for (size_t i = 0; i < terms_.size(); ++i) {
-    terms_[i]->averagedJacobian(q, ctx, z.segment(offsets_[i], sizes_[i]), term_jacobian);
-    jacobian += term_jacobian;
-  }
+  // Each term writes its own matrix and the sum comes last: adding right after a term's scalar
+  // stores would stall on store forwarding.
+  Eigen::Matrix4d parts[kMaxModelParameters];
+  const size_t m = terms_.size();
+  for (size_t i = 0; i < m; ++i)
+    terms_[i]->averagedJacobian(q, ctx, z.segment(offsets_[i], sizes_[i]), parts[i]);
+  jacobian = parts[0];
+  for (size_t i = 1; i < m; ++i) jacobian += parts[i];
 }
 
 Eigen::Matrix4d ResonatorModel::slowJacobian(const Eigen::Vector4d& q, const SlowContext& ctx,

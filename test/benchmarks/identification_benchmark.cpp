@@ -65,6 +65,36 @@ void BM_ForcedBatch14Params1e6Points(benchmark::State& state) {
 }
 BENCHMARK(BM_ForcedBatch14Params1e6Points)->Unit(benchmark::kMillisecond);
 
+// One evaluation of D(q) and of G = d(D(q) z)/dq (the per-sample work of the two passes).
+void BM_Regressor13Params(benchmark::State& state) {
+  const ResonatorModel model(kFreeDecayModel, ExperimentMode::kFreeDecay);
+  RegressionBlockMatrix d(4, model.numParameters());
+  Eigen::Vector4d q(0.8, -0.3, 0.2, 0.1);
+  SlowContext ctx;
+  for (auto _ : state) {
+    q[0] += 1e-9;
+    model.regressor(q, ctx, d);
+    benchmark::DoNotOptimize(d.data());
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_Regressor13Params);
+
+void BM_RegressorJacobian13Params(benchmark::State& state) {
+  const ResonatorModel model(kFreeDecayModel, ExperimentMode::kFreeDecay);
+  const Eigen::VectorXd z = Eigen::VectorXd::LinSpaced(model.numParameters(), -1.0, 1.0);
+  Eigen::Vector4d q(0.8, -0.3, 0.2, 0.1);
+  Eigen::Matrix4d g;
+  SlowContext ctx;
+  for (auto _ : state) {
+    q[0] += 1e-9;
+    model.regressorJacobian(q, ctx, z, g);
+    benchmark::DoNotOptimize(g.data());
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_RegressorJacobian13Params);
+
 void BM_RlsBlockUpdate13Params(benchmark::State& state) {
   const int k = 13;
   std::mt19937_64 gen(3);

@@ -12,6 +12,17 @@
 
 namespace cvg_bench {
 
+/// x y without the C99 Annex G infinity/NaN recovery of operator* (a library call per product):
+/// the operands here are finite polynomials of finite samples.
+inline std::complex<double> mul(const std::complex<double>& x, const std::complex<double>& y) {
+  return {x.real() * y.real() - x.imag() * y.imag(), x.real() * y.imag() + x.imag() * y.real()};
+}
+
+/// i x
+inline std::complex<double> timesI(const std::complex<double>& x) {
+  return {-x.imag(), x.real()};
+}
+
 /// Wirtinger derivatives of a column (A, B): x_y = dx/dy, suffix c = the conjugate variable.
 struct ComplexColumnDerivatives {
   std::complex<double> a_a, a_ac, a_b, a_bc;
@@ -22,13 +33,12 @@ struct ComplexColumnDerivatives {
 /// i xi~ / 4).
 inline void setComplexJacobian(const ComplexColumnDerivatives& d, const std::complex<double>& scale,
                                Eigen::Matrix4d& jacobian) {
-  const std::complex<double> i(0.0, 1.0);
   const std::complex<double> cols[2][4] = {
-      {d.a_a + d.a_ac, i * (d.a_a - d.a_ac), d.a_b + d.a_bc, i * (d.a_b - d.a_bc)},
-      {d.b_a + d.b_ac, i * (d.b_a - d.b_ac), d.b_b + d.b_bc, i * (d.b_b - d.b_bc)}};
+      {d.a_a + d.a_ac, timesI(d.a_a - d.a_ac), d.a_b + d.a_bc, timesI(d.a_b - d.a_bc)},
+      {d.b_a + d.b_ac, timesI(d.b_a - d.b_ac), d.b_b + d.b_bc, timesI(d.b_b - d.b_bc)}};
   for (int row = 0; row < 2; ++row) {
     for (int c = 0; c < 4; ++c) {
-      const std::complex<double> v = scale * cols[row][c];
+      const std::complex<double> v = mul(scale, cols[row][c]);
       jacobian(2 * row, c) = v.real();
       jacobian(2 * row + 1, c) = v.imag();
     }
@@ -41,13 +51,13 @@ inline ComplexColumnDerivatives cubicColumnDerivatives(const SlowComplex& z, dou
   const std::complex<double> a = z.a, b = z.b, ac = std::conj(z.a), bc = std::conj(z.b);
   ComplexColumnDerivatives d;
   d.a_a = 2.0 * z.n_sq + (2.0 + 2.0 * sigma) * std::norm(a);
-  d.a_ac = 2.0 * a * a + sigma * z.s;
-  d.a_b = 2.0 * bc * a + 2.0 * sigma * b * ac;
-  d.a_bc = 2.0 * a * b;
+  d.a_ac = 2.0 * mul(a, a) + sigma * z.s;
+  d.a_b = 2.0 * mul(bc, a) + 2.0 * sigma * mul(b, ac);
+  d.a_bc = 2.0 * mul(a, b);
   d.b_b = 2.0 * z.n_sq + (2.0 + 2.0 * sigma) * std::norm(b);
-  d.b_bc = 2.0 * b * b + sigma * z.s;
-  d.b_a = 2.0 * ac * b + 2.0 * sigma * a * bc;
-  d.b_ac = 2.0 * a * b;
+  d.b_bc = 2.0 * mul(b, b) + sigma * z.s;
+  d.b_a = 2.0 * mul(ac, b) + 2.0 * sigma * mul(a, bc);
+  d.b_ac = d.a_bc;
   return d;
 }
 
@@ -60,19 +70,21 @@ inline ComplexColumnDerivatives quinticColumnDerivatives(const SlowComplex& z) {
   const double c0 = 2.0 * n * n + std::norm(s);
   const std::complex<double> c1 = 2.0 * n * s;
   // d c0 and d c1 with respect to a, conj(a), b, conj(b).
-  const std::complex<double> c0_a = 4.0 * n * ac + 2.0 * a * sc, c0_ac = 4.0 * n * a + 2.0 * ac * s;
-  const std::complex<double> c0_b = 4.0 * n * bc + 2.0 * b * sc, c0_bc = 4.0 * n * b + 2.0 * bc * s;
-  const std::complex<double> c1_a = 2.0 * ac * s + 4.0 * n * a, c1_ac = 2.0 * a * s;
-  const std::complex<double> c1_b = 2.0 * bc * s + 4.0 * n * b, c1_bc = 2.0 * b * s;
+  const std::complex<double> c0_a = 4.0 * n * ac + 2.0 * mul(a, sc);
+  const std::complex<double> c0_ac = 4.0 * n * a + 2.0 * mul(ac, s);
+  const std::complex<double> c0_b = 4.0 * n * bc + 2.0 * mul(b, sc);
+  const std::complex<double> c0_bc = 4.0 * n * b + 2.0 * mul(bc, s);
+  const std::complex<double> c1_a = 2.0 * mul(ac, s) + 4.0 * n * a, c1_ac = 2.0 * mul(a, s);
+  const std::complex<double> c1_b = 2.0 * mul(bc, s) + 4.0 * n * b, c1_bc = 2.0 * mul(b, s);
   ComplexColumnDerivatives d;
-  d.a_a = c0_a * a + c0 + c1_a * ac;
-  d.a_ac = c0_ac * a + c1_ac * ac + c1;
-  d.a_b = c0_b * a + c1_b * ac;
-  d.a_bc = c0_bc * a + c1_bc * ac;
-  d.b_a = c0_a * b + c1_a * bc;
-  d.b_ac = c0_ac * b + c1_ac * bc;
-  d.b_b = c0_b * b + c0 + c1_b * bc;
-  d.b_bc = c0_bc * b + c1_bc * bc + c1;
+  d.a_a = mul(c0_a, a) + c0 + mul(c1_a, ac);
+  d.a_ac = mul(c0_ac, a) + mul(c1_ac, ac) + c1;
+  d.a_b = mul(c0_b, a) + mul(c1_b, ac);
+  d.a_bc = mul(c0_bc, a) + mul(c1_bc, ac);
+  d.b_a = mul(c0_a, b) + mul(c1_a, bc);
+  d.b_ac = mul(c0_ac, b) + mul(c1_ac, bc);
+  d.b_b = mul(c0_b, b) + c0 + mul(c1_b, bc);
+  d.b_bc = mul(c0_bc, b) + mul(c1_bc, bc) + c1;
   return d;
 }
 
