@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
   using namespace cvg_bench::tools;
   // Ceres logs failed evaluations through glog; the tool reports outcomes itself (notes, exit
   // codes).
-  FLAGS_minloglevel = google::GLOG_ERROR;
+  FLAGS_minloglevel = google::GLOG_FATAL;
   const std::map<std::string, int (*)(const std::vector<std::string>&)> commands = {
       {"simulate", runSimulate},
       {"demod", runDemod},
