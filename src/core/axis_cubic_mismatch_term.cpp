@@ -1,6 +1,7 @@
 // Unequal cubic stiffness of the two axes (beyond the paper): the f equation has (xi + xi_diff) N f
 // and the g equation (xi - xi_diff) N g. xi_diff is tilde (÷ omega). Averaging as for xi:
 //   2 a' = (i xi_diff / 4)(2 N a + S conj(a)),  2 b' = -(i xi_diff / 4)(2 N b + S conj(b)).
+#include "cvg_bench/core/complex_product.h"
 #include "cvg_bench/core/model_terms.h"
 #include "cvg_bench/core/slow_complex.h"
 #include "cvg_bench/core/slow_complex_jacobian.h"
@@ -19,8 +20,8 @@ class AxisCubicMismatchTerm : public ModelTerm {
                        Eigen::Ref<Eigen::MatrixXd> d) const override {
     const SlowComplex z(q);
     const std::complex<double> k(0.0, 0.25);
-    setComplexColumn(k * (2.0 * z.n_sq * z.a + z.s * std::conj(z.a)),
-                     -k * (2.0 * z.n_sq * z.b + z.s * std::conj(z.b)), d, 0);
+    setComplexColumn(mul(k, 2.0 * z.n_sq * z.a + mul(z.s, std::conj(z.a))),
+                     -mul(k, 2.0 * z.n_sq * z.b + mul(z.s, std::conj(z.b))), d, 0);
   }
   void averagedJacobian(const Eigen::Vector4d& q, const SlowContext&,
                         const Eigen::Ref<const Eigen::VectorXd>& z_term,

@@ -1,8 +1,9 @@
 // Cubic stiffness xi (f^2 + g^2) f (likewise g) of (2.2)/(2.3); parameter xi~ = xi / omega.
 // First-order averaging (first harmonic of N f with f = Re(a e^{-i w t})):
 //   2 a' = (i xi~ / 4)(2 N a + S conj(a)),  2 b' = (i xi~ / 4)(2 N b + S conj(b)),
-// which is the paper's k1..k4 (E = 3N/4, X = (p2 q1 - p1 q2)/2); single mode 2 q1' = -(3/4) xi~
-// p1^3.
+// which is the paper's k1..k4 (E = 3N/4, X = (p2 q1 - p1 q2)/2);
+// single mode 2 q1' = -(3/4) xi~ p1^3.
+#include "cvg_bench/core/complex_product.h"
 #include "cvg_bench/core/model_terms.h"
 #include "cvg_bench/core/slow_complex.h"
 #include "cvg_bench/core/slow_complex_jacobian.h"
@@ -21,8 +22,8 @@ class CubicStiffnessTerm : public ModelTerm {
                        Eigen::Ref<Eigen::MatrixXd> d) const override {
     const SlowComplex z(q);
     const std::complex<double> k(0.0, 0.25);
-    setComplexColumn(k * (2.0 * z.n_sq * z.a + z.s * std::conj(z.a)),
-                     k * (2.0 * z.n_sq * z.b + z.s * std::conj(z.b)), d, 0);
+    setComplexColumn(mul(k, 2.0 * z.n_sq * z.a + mul(z.s, std::conj(z.a))),
+                     mul(k, 2.0 * z.n_sq * z.b + mul(z.s, std::conj(z.b))), d, 0);
   }
   void averagedJacobian(const Eigen::Vector4d& q, const SlowContext&,
                         const Eigen::Ref<const Eigen::VectorXd>& z_term,

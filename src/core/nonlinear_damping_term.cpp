@@ -3,6 +3,7 @@
 // First harmonic of N f' with f' = Re(-i w a e^{-i w t}) gives
 //   2 a' = -(gamma_nl / 4)(2 N a - S conj(a)),  likewise b;
 // single mode: 2 a' = -(gamma_nl |a|^2 / 4) a, i.e. an effective damping gamma + gamma_nl A^2 / 4.
+#include "cvg_bench/core/complex_product.h"
 #include "cvg_bench/core/model_terms.h"
 #include "cvg_bench/core/slow_complex.h"
 #include "cvg_bench/core/slow_complex_jacobian.h"
@@ -22,8 +23,8 @@ class NonlinearDampingTerm : public ModelTerm {
   void averagedColumns(const Eigen::Vector4d& q, const SlowContext&,
                        Eigen::Ref<Eigen::MatrixXd> d) const override {
     const SlowComplex z(q);
-    setComplexColumn(-0.25 * (2.0 * z.n_sq * z.a - z.s * std::conj(z.a)),
-                     -0.25 * (2.0 * z.n_sq * z.b - z.s * std::conj(z.b)), d, 0);
+    setComplexColumn(-0.25 * (2.0 * z.n_sq * z.a - mul(z.s, std::conj(z.a))),
+                     -0.25 * (2.0 * z.n_sq * z.b - mul(z.s, std::conj(z.b))), d, 0);
   }
   void averagedJacobian(const Eigen::Vector4d& q, const SlowContext&,
                         const Eigen::Ref<const Eigen::VectorXd>& z_term,

@@ -2,6 +2,7 @@
 // omega. First-order averaging gives
 //   2 a' = (i kappa~ / 8)((2 N^2 + |S|^2) a + 2 N S conj(a)),  likewise b;
 // single mode 2 q1' = -(5/8) kappa~ p1^5. The paper prints k5..k8 with 1/16 (NOTES.md item 1).
+#include "cvg_bench/core/complex_product.h"
 #include "cvg_bench/core/model_terms.h"
 #include "cvg_bench/core/slow_complex.h"
 #include "cvg_bench/core/slow_complex_jacobian.h"
@@ -22,8 +23,8 @@ class QuinticStiffnessTerm : public ModelTerm {
     const std::complex<double> k(0.0, 0.125);
     const double c0 = 2.0 * z.n_sq * z.n_sq + std::norm(z.s);
     const std::complex<double> c1 = 2.0 * z.n_sq * z.s;
-    setComplexColumn(k * (c0 * z.a + c1 * std::conj(z.a)), k * (c0 * z.b + c1 * std::conj(z.b)), d,
-                     0);
+    setComplexColumn(mul(k, c0 * z.a + mul(c1, std::conj(z.a))),
+                     mul(k, c0 * z.b + mul(c1, std::conj(z.b))), d, 0);
   }
   void averagedJacobian(const Eigen::Vector4d& q, const SlowContext&,
                         const Eigen::Ref<const Eigen::VectorXd>& z_term,

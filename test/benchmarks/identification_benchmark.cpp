@@ -95,6 +95,25 @@ void BM_RegressorJacobian13Params(benchmark::State& state) {
 }
 BENCHMARK(BM_RegressorJacobian13Params);
 
+// The streaming QR alone: 10^5 blocks of 4 rows, 13 parameters (+ right-hand side).
+void BM_IncrementalQr13Params1e5Blocks(benchmark::State& state) {
+  const int k = 13;
+  std::mt19937_64 gen(4);
+  std::normal_distribution<double> n01;
+  std::vector<RegressionBlockMatrix> blocks(64, RegressionBlockMatrix(4, k));
+  for (auto& d : blocks)
+    for (int j = 0; j < k; ++j)
+      for (int i = 0; i < 4; ++i) d(i, j) = n01(gen);
+  const Eigen::Vector4d y(0.1, -0.2, 0.3, 0.05);
+  for (auto _ : state) {
+    IncrementalQr qr(k);
+    for (long b = 0; b < 100000; ++b) qr.addBlock(blocks[b % 64], y);
+    benchmark::DoNotOptimize(qr.rAug().data());
+  }
+  state.SetItemsProcessed(state.iterations() * 100000L);
+}
+BENCHMARK(BM_IncrementalQr13Params1e5Blocks)->Unit(benchmark::kMillisecond);
+
 void BM_RlsBlockUpdate13Params(benchmark::State& state) {
   const int k = 13;
   std::mt19937_64 gen(3);

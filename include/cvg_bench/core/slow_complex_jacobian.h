@@ -8,20 +8,10 @@
 #include <Eigen/Core>
 #include <complex>
 
+#include "cvg_bench/core/complex_product.h"
 #include "cvg_bench/core/slow_complex.h"
 
 namespace cvg_bench {
-
-/// x y without the C99 Annex G infinity/NaN recovery of operator* (a library call per product):
-/// the operands here are finite polynomials of finite samples.
-inline std::complex<double> mul(const std::complex<double>& x, const std::complex<double>& y) {
-  return {x.real() * y.real() - x.imag() * y.imag(), x.real() * y.imag() + x.imag() * y.real()};
-}
-
-/// i x
-inline std::complex<double> timesI(const std::complex<double>& x) {
-  return {-x.imag(), x.real()};
-}
 
 /// Wirtinger derivatives of a column (A, B): x_y = dx/dy, suffix c = the conjugate variable.
 struct ComplexColumnDerivatives {
