@@ -192,7 +192,8 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
     auto finish = [&](SampleTerms& a, const Eigen::Vector4d& q, double t) {
       jctx.t_s = t;
       model.regressorJacobian(q, jctx, z, g);
-      x.noalias() = a.u - g.transpose() * a.v;
+      const Eigen::Matrix4d gt = g.transpose();
+      for (int c = 0; c < k; ++c) x.col(c) = a.u.col(c) - gt * a.v.col(c);  // fixed-size 4x4
       wbuf.middleCols<4>(4 * in_buf) = x.transpose();
       if (++in_buf == kBatch) {
         meat.selfadjointView<Eigen::Lower>().rankUpdate(wbuf);
@@ -204,7 +205,8 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
     long in_record = 0;
     stream([&](int, const RegressionBlock& b) {
       const RegressionBlockMatrix& d = *b.d;
-      const Eigen::Vector4d r = b.y - d * z;
+      Eigen::Vector4d r = b.y;
+      for (int c = 0; c < k; ++c) r -= z[c] * d.col(c);
       rss += r.squaredNorm();
       if (in_record >= 2) lag2 += r.dot(r_hist[1]);
       r_hist[1] = r_hist[0];
