@@ -203,9 +203,12 @@ void IdentifierNode::identifyNow(const IdentificationOptions& options) {
     throw InputError("only " + std::to_string(have) +
                      (mode_ == ExperimentMode::kFreeDecay ? " slow states" : " sweep points") +
                      " buffered; min_samples is " + std::to_string(options_.min_samples));
-  Estimate e = mode_ == ExperimentMode::kFreeDecay
-                   ? identifyFreeDecay(bufferedSlowRecord(), options)
-                   : identifyForced(sweep_, options);
+  // In `rls` mode the recursive estimate streams already; the window's batch estimate is the
+  // honest least-squares one (same z at forgetting 1, NOTES.md item 9, with honest intervals).
+  IdentificationOptions batch = options;
+  if (batch.method == "rls") batch.method = "ls";
+  Estimate e = mode_ == ExperimentMode::kFreeDecay ? identifyFreeDecay(bufferedSlowRecord(), batch)
+                                                   : identifyForced(sweep_, batch);
   estimate_ = e;
   window_start_ = stamps_.front();
   window_end_ = stamps_.back();

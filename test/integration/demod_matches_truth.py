@@ -11,6 +11,7 @@ import rospy
 import rostest
 
 from cvg_bench.msg import SimulationTruth, SlowState
+from diagnostic_msgs.msg import DiagnosticArray
 from cvg_bench.srv import StartFreeDecay
 
 EPOCH_TOL_NS = 0
@@ -27,6 +28,14 @@ class DemodMatchesTruth(unittest.TestCase):
         rospy.Subscriber("/cvg/truth", SimulationTruth, self.on_truth)
         rospy.Subscriber("/cvg/slow", SlowState, self.on_demod)
         rospy.Subscriber("/cvg/sim/slow_truth", SlowState, self.on_exact)
+        self.diagnostics = None
+        rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diagnostics)
+
+    def on_diagnostics(self, msg):
+        for status in msg.status:
+            if status.name.endswith("demodulator") and any(kv.key == "accepted" for kv in status.values):
+                with self.lock:
+                    self.diagnostics = {kv.key: kv.value for kv in status.values}
 
     def on_truth(self, msg):
         with self.lock:
@@ -110,6 +119,14 @@ class DemodMatchesTruth(unittest.TestCase):
         self.assertLess(worst, tol)
         # The typical error is the noise plus the averaging error, not a phase or scale slip.
         self.assertLess(rms, sigma_slow * 2.0 + eps * amp)
+
+        # Diagnostics carry the sample counters: every raw sample accepted, none dropped.
+        n_raw = truth.n_raw_samples
+        self.wait_until(lambda: self.diagnostics is not None and
+                        int(self.diagnostics.get("accepted", "0")) >= n_raw, 10.0,
+                        "demodulator diagnostics counting %d accepted samples" % n_raw)
+        self.assertEqual(int(self.diagnostics["rejected_total"]), 0)
+        self.assertEqual(int(self.diagnostics["accepted"]), n_raw)
 
 
 if __name__ == "__main__":

@@ -1,0 +1,45 @@
+#!/usr/bin/python3
+"""rostest: the identifier's recursive mode. Slow states replayed from a bag are fed one by one to
+block RLS (2.12) (forgetting factor 1, corrected pairing, NOTES.md item 9); its estimate after the
+last state equals the batch least-squares estimate the node computes when the replay stops, to
+rounding (relative 1e-8 of each value's standard error scale)."""
+import threading
+import unittest
+
+import rosbag
+import rospy
+import rostest
+
+from cvg_bench.msg import ModelEstimate
+
+
+class RlsEqualsBatch(unittest.TestCase):
+    def test_recursive_estimate_reaches_the_batch_estimate(self):
+        bag = rospy.get_param("~bag")
+        timeout = rospy.get_param("~timeout_s", 40.0)
+        with rosbag.Bag(bag) as b:
+            n = b.get_message_count("/cvg/slow")
+        got = {}
+        done = threading.Event()
+
+        def on_estimate(msg):
+            if msg.n_samples == n:
+                got.setdefault(msg.method, msg)
+            if "rls" in got and "ls" in got:
+                done.set()
+
+        rospy.Subscriber("/cvg/estimate", ModelEstimate, on_estimate)
+        self.assertTrue(done.wait(timeout), "got %s within %g s, need rls and ls over %d states" %
+                        (sorted(got), timeout, n))
+        rls, ls = got["rls"], got["ls"]
+        self.assertEqual(rls.names, ls.names)
+        self.assertEqual(rls.n_equations, ls.n_equations)
+        for i, name in enumerate(ls.names):
+            scale = max(ls.std_errors[i], 1e-12)
+            self.assertLess(abs(rls.values[i] - ls.values[i]) / scale, 1e-6, name)
+        self.assertAlmostEqual(rls.sigma, ls.sigma, delta=1e-9 * ls.sigma)
+
+
+if __name__ == "__main__":
+    rospy.init_node("rls_equals_batch_test")
+    rostest.rosrun("cvg_bench", "rls_equals_batch", RlsEqualsBatch)
