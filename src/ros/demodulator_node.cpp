@@ -66,8 +66,10 @@ bool DemodulatorNode::onReset(Reset::Request&, Reset::Response& res) {
 void DemodulatorNode::onRaw(const RawSampleBatch::ConstPtr& msg) {
   ++batches_;
   const ros::Time now = ros::Time::now();
+  // A /clock that jumps back (replay restarted) is reported; the reset itself is decided by the
+  // data's own stamps below, so a batch processed before the clock message is not reset twice.
   if (!last_now_.isZero() && now < last_now_)
-    resetState("ROS time jumped back (replay restarted?)");
+    ROS_INFO("demodulator: ROS time jumped back by %.6g s", secondsSince(last_now_, now));
   last_now_ = now;
 
   const double w =

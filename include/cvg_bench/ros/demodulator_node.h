@@ -2,8 +2,9 @@
 // streaming demodulator (demodulator.h). Bad samples are dropped and counted by the core; the node
 // warns at most every warn_throttle_s and publishes the counters as diagnostics. The demodulator
 // is rebuilt when the reference frequency or the sample rate of the data changes, and reset when
-// the data jump back in time (a looping bag, a restarted experiment: new phase epoch) or ROS time
-// itself jumps back (/clock of a replay restarting). Service `demodulator/reset` clears it.
+// the data jump back in time (a looping bag, a restarted experiment: new phase epoch); a /clock
+// jumping back is logged (the data stamps decide: one loop, one reset). Service
+// `demodulator/reset` clears it.
 // Sample times enter the core relative to the phase epoch (conversions.h), exactly.
 #pragma once
 
