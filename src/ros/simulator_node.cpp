@@ -44,8 +44,24 @@ SimulatorNode::SimulatorNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
                                &SimulatorNode::onTick, this);
   ROS_INFO("resonator simulator: preset '%s' (%s), omega = %.6g rad/s", preset_.name.c_str(),
            preset_.description.c_str(), preset_.omega_rad_s);
-  if (options_.autostart == "free_decay") startFreeDecay(0.0, options_.seed);
-  if (options_.autostart == "forced") startSweep(preset_, options_.seed);
+  if (options_.autostart != "none") {
+    // Start once the first consumer is connected (nodes of a launch file come up in any order);
+    // start_delay_s then leaves the rest of the chain time to connect.
+    autostart_timer_ =
+        nh_.createWallTimer(ros::WallDuration(0.05), [this](const ros::WallTimerEvent&) {
+          const ros::Publisher& first = options_.autostart == "forced" ? sweep_pub_
+                                        : options_.publish_raw         ? raw_pub_
+                                                                       : slow_pub_;
+          if (first.getNumSubscribers() == 0) return;
+          autostart_timer_.stop();
+          try {
+            if (options_.autostart == "free_decay") startFreeDecay(0.0, options_.seed);
+            if (options_.autostart == "forced") startSweep(preset_, options_.seed);
+          } catch (const std::exception& e) {
+            ROS_ERROR("autostart failed: %s", e.what());
+          }
+        });
+  }
 }
 
 bool SimulatorNode::onStartFreeDecay(StartFreeDecay::Request& req, StartFreeDecay::Response& res) {

@@ -43,7 +43,7 @@ class SimulatorNode {
 
   ros::Publisher raw_pub_, slow_pub_, slow_truth_pub_, sweep_pub_, truth_pub_;
   ros::ServiceServer start_free_decay_srv_, start_sweep_srv_;
-  ros::WallTimer timer_;
+  ros::WallTimer timer_, autostart_timer_;
 
   Running running_ = Running::kNone;
   RawRecord raw_;

@@ -14,6 +14,8 @@ struct SimulatorNodeOptions {
   /// Preset YAML file; when set it replaces `preset`.
   std::string config;
   /// Experiment started at start-up: "free_decay", "forced" or "none" (wait for a service call).
+  /// It starts when the first consumer (of `raw`, else `sim/slow`; `sweep` when forced) connects,
+  /// start_delay_s later.
   std::string autostart = "none";
   /// Publish raw f, g batches on `raw` (free decay).
   bool publish_raw = true;
