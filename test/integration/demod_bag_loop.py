@@ -14,6 +14,7 @@ import roslib.packages
 import rospy
 import rostest
 
+from bag_player import BagPlayer
 from cvg_bench.msg import RawSampleBatch, SlowState
 from diagnostic_msgs.msg import DiagnosticArray
 
@@ -92,14 +93,11 @@ class DemodBagLoop(unittest.TestCase):
 
         rospy.Subscriber("/cvg/slow", SlowState, on_slow, queue_size=100000)
         rospy.Subscriber("/diagnostics", DiagnosticArray, on_diag)
-        rospy.wait_for_service("/cvg/demodulator/reset", timeout)
-        player = subprocess.Popen(["rosbag", "play", "--clock", "--loop", "--quiet", "--delay=1.0", bag_path],
-                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        player = BagPlayer(bag_path, ["/cvg/demodulator/reset"], timeout, loop=True)
         try:
             self.assertTrue(enough.wait(timeout), "the bag did not loop twice within %g s" % timeout)
         finally:
-            player.terminate()
-            player.wait(10)
+            player.stop()
         with lock:
             first, second = passes[0], passes[1]
         self.assertGreater(len(first), 20)

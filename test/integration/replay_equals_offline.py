@@ -14,8 +14,12 @@ import roslib.packages
 import rospy
 import rostest
 
+from bag_player import BagPlayer
 from cvg_bench.msg import ModelEstimate
 from cvg_bench.srv import Explain, GetEstimate, Identify, PredictDrift, Reset
+
+
+PLAYED = []  # the bag is played once for all tests of this file
 
 
 def wait_for_full_estimate(test):
@@ -35,6 +39,8 @@ def wait_for_full_estimate(test):
             done.set()
 
     sub = rospy.Subscriber("/cvg/estimate", ModelEstimate, on_estimate)
+    if not PLAYED:
+        PLAYED.append(BagPlayer(bag, ["/cvg/identify"], timeout))
     test.assertTrue(done.wait(timeout), "no estimate over all %d slow states within %g s" % (n, timeout))
     sub.unregister()
     return got["estimate"], n
@@ -110,4 +116,8 @@ class ReplayEqualsOffline(unittest.TestCase):
 
 if __name__ == "__main__":
     rospy.init_node("replay_equals_offline_test")
-    rostest.rosrun("cvg_bench", "replay_equals_offline", ReplayEqualsOffline)
+    try:
+        rostest.rosrun("cvg_bench", "replay_equals_offline", ReplayEqualsOffline)
+    finally:
+        for player in PLAYED:
+            player.stop()

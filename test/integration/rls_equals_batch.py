@@ -10,6 +10,7 @@ import rosbag
 import rospy
 import rostest
 
+from bag_player import BagPlayer
 from cvg_bench.msg import ModelEstimate
 
 
@@ -29,7 +30,12 @@ class RlsEqualsBatch(unittest.TestCase):
                 done.set()
 
         rospy.Subscriber("/cvg/estimate", ModelEstimate, on_estimate)
-        self.assertTrue(done.wait(timeout), "got %s within %g s, need rls and ls over %d states" %
+        player = BagPlayer(bag, ["/cvg/identify"], timeout)
+        try:
+            finished = done.wait(timeout)
+        finally:
+            player.stop()
+        self.assertTrue(finished, "got %s within %g s, need rls and ls over %d states" %
                         (sorted(got), timeout, n))
         rls, ls = got["rls"], got["ls"]
         self.assertEqual(rls.names, ls.names)
