@@ -6,6 +6,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "bag_input.h"
 #include "cli_args.h"
 #include "cvg_bench/core/demodulator.h"
 #include "cvg_bench/core/errors.h"
@@ -22,7 +23,9 @@ const char* kHelp =
     "usage: cvg_ident demod INPUT [--omega W] [--rate HZ] [--columns t=COL,f=COL,g=COL] --out "
     "FILE\n"
     "                       [--attenuation DB] [--window S]\n"
-    "Demodulates raw f(t), g(t) (CSV) into the slow variables of (2.4):\n"
+    "Demodulates raw f(t), g(t) (CSV, or a .bag of RawSampleBatch messages: --topic NAME picks "
+    "the\n"
+    "topic) into the slow variables of (2.4):\n"
     "  f = p1 sin(W t) + q1 cos(W t),  g = p2 sin(W t) + q2 cos(W t)\n"
     "and writes t,q1,p1,q2,p2 with `# omega:` and `# mode: free_decay`.\n"
     "  --omega W      reference frequency [rad/s]; default the file's `# omega:`, else estimated\n"
@@ -39,7 +42,8 @@ const char* kHelp =
 }  // namespace
 
 int runDemod(const std::vector<std::string>& argv) {
-  const CliArgs args(argv, {"omega", "rate", "columns", "out", "attenuation", "window"}, {});
+  const CliArgs args(argv, {"omega", "rate", "columns", "out", "attenuation", "window", "topic"},
+                     {});
   if (args.help()) {
     std::cout << kHelp;
     return 0;
@@ -49,7 +53,8 @@ int runDemod(const std::vector<std::string>& argv) {
   RecordReadOptions ro;
   if (args.has("columns")) ro.raw_columns = parseRawColumnMap(args.get("columns"));
   ro.repair_raw_timestamps = true;
-  const AnyRecord any = readRecordCsv(args.positionals().front(), ro);
+  const AnyRecord any =
+      readRecordInput(args.positionals().front(), ro, args.get("topic"), {RecordKind::kRaw});
   if (any.kind != RecordKind::kRaw)
     throw InputError(args.positionals().front() + ": not a raw t,f,g record (found " +
                      recordKindName(any.kind) + " columns); use --columns to map raw columns");

@@ -5,6 +5,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "bag_input.h"
 #include "cli_args.h"
 #include "cvg_bench/core/demodulator.h"
 #include "cvg_bench/core/errors.h"
@@ -37,7 +38,7 @@ const char* kHelp =
     "and\n"
     "(unless --no-figures) PNG figures + report.md by scripts/explain_report.py.\n"
     "INPUT: t,q1,p1,q2,p2 (free decay), omega0,q1,p1,q2,p2 (forced) or raw t,f,g (demodulated\n"
-    "first at --omega or the file's omega).\n";
+    "first at --omega or the file's omega); or a .bag of the project's messages (--topic NAME).\n";
 
 std::vector<std::string> splitList(const std::string& s) {
   std::vector<std::string> out;
@@ -110,7 +111,7 @@ void printSummary(const Explanation& x) {
 int runExplain(const std::vector<std::string>& argv) {
   const CliArgs args(argv,
                      {"mode", "json", "report", "omega", "confidence", "angular-gain", "mu",
-                      "alpha", "candidates", "holdout-fraction", "columns"},
+                      "alpha", "candidates", "holdout-fraction", "columns", "topic"},
                      {"no-figures"});
   if (args.help()) {
     std::cout << kHelp;
@@ -136,7 +137,7 @@ int runExplain(const std::vector<std::string>& argv) {
   read.repair_raw_timestamps = true;
   if (args.has("columns")) read.raw_columns = parseRawColumnMap(args.get("columns"));
   const std::string input = args.positionals().front();
-  AnyRecord rec = readRecordCsv(input, read);
+  AnyRecord rec = readRecordInput(input, read, args.get("topic"));
   std::vector<std::string> input_notes;
   Explanation x;
   SlowRecord slow;

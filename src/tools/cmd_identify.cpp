@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <iostream>
 
+#include "bag_input.h"
 #include "cli_args.h"
 #include "cvg_bench/core/ceres_refinement.h"
 #include "cvg_bench/core/demodulator.h"
@@ -28,7 +29,10 @@ const char* kHelp =
     "                          [--json FILE]\n"
     "Estimates the model parameters with confidence intervals.\n"
     "  INPUT    CSV: t,q1,p1,q2,p2 (free decay), omega0,q1,p1,q2,p2 (forced sweep) or raw t,f,g\n"
-    "           (free decay; demodulated first at --omega / the file's omega / estimated).\n"
+    "           (free decay; demodulated first at --omega / the file's omega / estimated),\n"
+    "           or a rosbag (.bag) of the project's SlowState / SweepPoint / RawSampleBatch "
+    "messages\n"
+    "  --topic  bag topic to read (default: the one topic of a project message type)\n"
     "  --model  linear, or +-joined extensions: xi, kappa, gamma_nl, cm_rate (free decay), "
     "xi_diff,\n"
     "           mu (forced, needs --method ceres: mu multiplies u~ bilinearly).\n"
@@ -124,7 +128,9 @@ CeresOptions ceresOptionsFor(const IdentificationOptions& opt) {
 
 int runIdentify(const std::vector<std::string>& argv) {
   const CliArgs args(
-      argv, {"mode", "model", "method", "confidence", "omega", "angular-gain", "json", "mu"}, {});
+      argv,
+      {"mode", "model", "method", "confidence", "omega", "angular-gain", "json", "mu", "topic"},
+      {});
   if (args.help()) {
     std::cout << kHelp;
     return 0;
@@ -152,7 +158,7 @@ int runIdentify(const std::vector<std::string>& argv) {
   }
   RecordReadOptions ro;
   ro.repair_raw_timestamps = true;
-  const AnyRecord any = readRecordCsv(path, ro);
+  const AnyRecord any = readRecordInput(path, ro, args.get("topic"));
   std::vector<std::string> pre_notes;
   Estimate e;
   const bool want_mu = ("+" + opt.model + "+").find("+mu+") != std::string::npos;
