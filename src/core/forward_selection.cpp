@@ -79,6 +79,7 @@ SelectionResult forwardSelect(const NestedModelFitter& fitter,
     for (size_t i = 0; i < round.size(); ++i) {
       round[i].threshold = threshold;
       if (round[i].wald.p_value < threshold && round[i].holdout_ratio > options.min_holdout_ratio &&
+          round[i].sigma_ratio > 1.0 &&
           (best < 0 || round[i].wald.p_value < round[best].wald.p_value ||
            (round[i].wald.p_value == round[best].wald.p_value &&
             round[i].wald.f_statistic > round[best].wald.f_statistic)))

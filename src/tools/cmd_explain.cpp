@@ -96,7 +96,8 @@ void printSummary(const Explanation& x) {
               << "\n";
   for (const auto& s : x.selection.last_round)
     std::cout << "    (not accepted: " << s.added << ", p " << s.wald.p_value << " vs "
-              << s.threshold << ", hold-out " << s.holdout_ratio << ")\n";
+              << s.threshold << ", hold-out " << s.holdout_ratio << ", sigma ratio "
+              << s.sigma_ratio << ")\n";
   std::cout << "baseline residual signature: " << x.baseline_signature.describe(0.01) << "\n";
   std::cout << "selected: " << (x.selection.selected.empty() ? "none" : "");
   for (size_t i = 0; i < x.selection.selected.size(); ++i)

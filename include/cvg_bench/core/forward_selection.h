@@ -10,12 +10,13 @@
 //   holdout_ratio  hold-out RMS of the current model / that of the extended one (fit on part of
 //                  the data, predict the rest; see the fitter)
 // Accept the candidate with the smallest p-value among those with holdout_ratio >
-// min_holdout_ratio when p < alpha / m (Bonferroni over the m candidates tried at the step);
-// stop when none qualifies. Finally a backward check drops an accepted term whose Wald p-value in
-// the final model exceeds alpha / (number of accepted terms) (e.g. xi accepted first, then made
-// redundant by kappa). On clean data the family-wise false-discovery rate is then <= alpha per
-// step, as long as the honest covariance is honest (checked by test/core/hidden_effect_test.cpp
-// and scripts/validate_explain.py).
+// min_holdout_ratio and sigma_ratio > 1 (the extended fit must fit better: a nested output-error
+// fit that lands in a worse local minimum is not a discovery) when p < alpha / m (Bonferroni over
+// the m candidates tried at the step); stop when none qualifies. Finally a backward check drops an
+// accepted term whose Wald p-value in the final model exceeds alpha / (number of accepted terms)
+// (e.g. xi accepted first, then made redundant by kappa). On clean data the family-wise
+// false-discovery rate is then <= alpha per step, as long as the honest covariance is honest
+// (checked by test/core/hidden_effect_test.cpp and scripts/validate_explain.py).
 #pragma once
 
 #include <Eigen/Core>
