@@ -64,9 +64,20 @@ lines = [
         ["/usr/bin/python3", "-c", "import numpy; print(numpy.__version__)"],
         capture_output=True, text=True).stdout.strip(),
     "",
-    "| benchmark | C++ CPU time | C++ items/s | NumPy items/s | C++ / NumPy |",
-    "|---|---|---|---|---|",
+    "| benchmark | C++ CPU time | C++ items/s | NumPy items/s | C++ / NumPy | counters |",
+    "|---|---|---|---|---|---|",
 ]
+STANDARD = {"name", "family_index", "per_family_instance_index", "run_name", "run_type",
+            "repetitions", "repetition_index", "threads", "iterations", "real_time", "cpu_time",
+            "time_unit", "items_per_second", "bytes_per_second"}
+
+def counters(b):
+    out = []
+    for k, v in b.items():
+        if k in STANDARD:
+            continue
+        out.append("%s %s" % (k, si(v) if isinstance(v, (int, float)) else v))
+    return ", ".join(out)
 for b in cpp.get("benchmarks", []):
     if b.get("run_type") == "aggregate":
         continue
@@ -74,13 +85,46 @@ for b in cpp.get("benchmarks", []):
     ips = b.get("items_per_second")
     ref = numpy.get(name)
     ratio = "%.0fx" % (ips / ref["items_per_second"]) if ips and ref else ""
-    lines.append("| %s | %.4g %s | %s | %s | %s |" % (
+    lines.append("| %s | %.4g %s | %s | %s | %s | %s |" % (
         name, b["cpu_time"], b.get("time_unit", ""), si(ips) if ips else "",
-        si(ref["items_per_second"]) if ref else "", ratio))
+        si(ref["items_per_second"]) if ref else "", ratio, counters(b)))
 extra = [n for n in numpy if n not in {b["name"] for b in cpp.get("benchmarks", [])}]
 for n in extra:
     lines.append("| %s (NumPy only) | | | %s | |" % (n, si(numpy[n]["items_per_second"])))
 lines += ["", "Items: see each benchmark's comment (demodulator: f,g sample pairs).", ""]
+
+# The issues' targets against this run.
+by_name = {b["name"]: b for b in cpp.get("benchmarks", []) if b.get("run_type") != "aggregate"}
+
+def seconds(b):
+    scale = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}[b.get("time_unit", "ns")]
+    return b["cpu_time"] * scale
+
+targets = []
+def target(what, name, value_fn, fmt, ok_fn, goal):
+    b = by_name.get(name)
+    if b is None:
+        targets.append("| %s | (not run) | %s | |" % (what, goal))
+        return
+    v = value_fn(b)
+    targets.append("| %s | %s | %s | %s |" % (what, fmt % v, goal, "met" if ok_fn(v) else "NOT met"))
+
+target("demodulator throughput, 120 dB chain", "demod_uniform/1000000",
+       lambda b: b["items_per_second"] / 1e6, "%.0f M pairs/s", lambda v: v >= 100, ">= 100 M pairs/s")
+target("simulator, MEMS ring full equations, free decay", "BM_FullEquationsMemsRing/0",
+       lambda b: b["x_real_time"], "%.1fx real time", lambda v: v >= 20, ">= 20x")
+target("simulator, MEMS ring full equations, forced", "BM_FullEquationsMemsRing/1",
+       lambda b: b["x_real_time"], "%.1fx real time", lambda v: v >= 20, ">= 20x")
+target("averaged model, hour-long HRG ring-down", "BM_AveragedModelHrgHourRingDown",
+       lambda b: b["x_real_time"], "%.3gx real time", lambda v: v >= 1, "faster than real time")
+target("batch identification, 10^6 samples, 13 params (free decay)", "BM_FreeDecayBatch13Params1e6Samples",
+       seconds, "%.3f s", lambda v: v <= 0.5, "<= 0.5 s")
+target("batch identification, 10^6 points, 14 params (forced)", "BM_ForcedBatch14Params1e6Points",
+       seconds, "%.3f s", lambda v: v <= 0.5, "<= 0.5 s")
+target("RLS block update, 13 params", "BM_RlsBlockUpdate13Params",
+       lambda b: seconds(b) * 1e6, "%.2f us", lambda v: v <= 2.0, "<= 2 us")
+lines += ["## Targets of the issues (this run)", "",
+          "| what | measured | target | |", "|---|---|---|---|"] + targets + [""]
 open(md_path, "w").write("\n".join(lines))
 print("run_benchmarks: wrote", md_path)
 PY

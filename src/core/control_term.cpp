@@ -54,8 +54,10 @@ class ControlTerm : public ModelTerm {
   }
   void fastColumns(const FastState& s, const FastContext& c,
                    Eigen::Ref<Eigen::MatrixXd> cols) const override {
-    const double w = c.omega_rad_s, sn = std::sin(c.drive_phase_rad),
-                 cs = std::cos(c.drive_phase_rad);
+    const double w = c.omega_rad_s;
+    const bool given = !std::isnan(c.drive_sin) && !std::isnan(c.drive_cos);
+    const double sn = given ? c.drive_sin : std::sin(c.drive_phase_rad);
+    const double cs = given ? c.drive_cos : std::cos(c.drive_phase_rad);
     const double af = w * (1 + 3 * c.mu * s.f * s.f), ag = w * (1 + 3 * c.mu * s.g * s.g);
     cols.setZero();
     cols(0, 0) = -af * sn;

@@ -81,7 +81,8 @@ FastState FastSimulator::fastState() const {
 Eigen::Vector4d FastSimulator::rhs(double t, const Eigen::Vector4d& x, double c, double s) const {
   const FastState st{x[0] * c + x[1] * s, w_ * (x[1] * c - x[0] * s), x[2] * c + x[3] * s,
                      w_ * (x[3] * c - x[2] * s)};
-  const FastContext ctx{omega_, w_ * t, t, mu_};
+  // The reference runs at W = omega0, the drive frequency: (c, s) are the drive phase's cos, sin.
+  const FastContext ctx{omega_, w_ * t, t, mu_, s, c};
   Eigen::Vector2d force = modelForce(st, ctx);
   if (pumping_.active()) force += pumping_.force(st.f, st.g, w_ * t, omega_);
   const double detune = w_ * w_ - omega_ * omega_, inv_w = 1.0 / w_;

@@ -15,6 +15,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -47,6 +48,10 @@ struct FastContext {
   double t_s = 0.0;
   /// Known control nonlinearity mu.
   double mu = 0.0;
+  /// Optional sin and cos of drive_phase_rad, precomputed by a caller that has them anyway (the
+  /// simulator's reference at W = omega0); NaN (the default) means "compute from the phase".
+  double drive_sin = std::numeric_limits<double>::quiet_NaN();
+  double drive_cos = std::numeric_limits<double>::quiet_NaN();
 };
 
 class ModelTerm {
