@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/simd_vector4.h"
 
-#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace cvg_bench {
 namespace {
@@ -53,19 +53,12 @@ std::vector<double> kaiserSinc(const LowpassSpec& s, size_t n) {
   return h;
 }
 
-using V4 = double __attribute__((vector_size(32)));
-
-inline V4 load4(const double* p) {
-  V4 v;
-  std::memcpy(&v, p, sizeof(v));
-  return v;
-}
+using simd::load4;
+using simd::V4;
 
 /// One output of the symmetric filter on 4 interleaved channels: x points at the window start.
 /// Two accumulator chains keep the adder pipeline busy.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-__attribute__((target_clones("arch=x86-64-v3", "default")))
-#endif
+CVG_HOT_CLONES
 void symmetricDot4(const double* half_taps, size_t half, double centre_tap, const double* x,
                    size_t n_taps, double* out) {
   V4 acc0 = centre_tap * load4(x + 4 * half);

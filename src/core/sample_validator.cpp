@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/simd_vector4.h"
 
-#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace cvg_bench {
 
@@ -53,22 +53,15 @@ void SampleValidator::reset() {
 
 namespace {
 
-using V4 = double __attribute__((vector_size(32)));
+using simd::load4;
+using simd::V4;
 using M4 = long long __attribute__((vector_size(32)));
-
-inline V4 load4(const double* p) {
-  V4 v;
-  std::memcpy(&v, p, sizeof(v));
-  return v;
-}
 
 /// Number of samples i >= 1 that are not finite or not one period after sample i - 1, four at a
 /// time and branch-free, so that the clean batches of a running bench cost well under 1 ns each.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-__attribute__((target_clones("arch=x86-64-v3", "default")))
-#endif
-size_t
-countIrregular(const double* t, const double* f, const double* g, size_t n, double dt, double tol) {
+CVG_HOT_CLONES
+size_t countIrregular(const double* t, const double* f, const double* g, size_t n, double dt,
+                      double tol) {
   M4 bad4 = {0, 0, 0, 0};
   const V4 dt4 = {dt, dt, dt, dt}, tol4 = {tol, tol, tol, tol}, zero = {0.0, 0.0, 0.0, 0.0};
   size_t i = 1;

@@ -1,0 +1,29 @@
+// Four doubles as one GCC vector (the hot loops of the demodulator chain: the 4-channel filter and
+// the batch validator), with an unaligned load, and CVG_HOT_CLONES to compile a function also for
+// x86-64-v3 (AVX2/FMA) with dispatch at load time. Portable: the default clone is plain x86-64.
+#pragma once
+
+#include <cstring>
+
+// The vectors never cross an ABI boundary (inline helpers of two translation units).
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace cvg_bench {
+namespace simd {
+
+using V4 = double __attribute__((vector_size(32)));
+
+inline V4 load4(const double* p) {
+  V4 v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+}
+
+}  // namespace simd
+}  // namespace cvg_bench
+
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+#define CVG_HOT_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define CVG_HOT_CLONES
+#endif
