@@ -5,8 +5,7 @@
 #include <sstream>
 
 #include "cvg_bench/core/errors.h"
-
-#pragma GCC diagnostic ignored "-Wpsabi"
+#include "cvg_bench/core/simd_vector4.h"
 
 namespace cvg_bench {
 namespace {
@@ -50,15 +49,12 @@ std::vector<FilterStage> planStages(double fs, int m, double fp, double fst, dou
   return best;
 }
 
-using V4 = double __attribute__((vector_size(32)));
+using simd::V4;
 
 /// Writes 4 interleaved channels (2 f cos, 2 f sin, 2 g cos, 2 g sin) for n samples whose
 /// reference phase is phase0 + k dphi: four rotation lanes stepped by 4 dphi.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-__attribute__((target_clones("arch=x86-64-v3", "default")))
-#endif
-void mixBlock(const double* f, const double* g, size_t n, double phase0, double dphi,
-              double* out) {
+CVG_HOT_CLONES
+void mixBlock(const double* f, const double* g, size_t n, double phase0, double dphi, double* out) {
   V4 c, s;
   for (int l = 0; l < 4; ++l) {
     c[l] = 2.0 * std::cos(phase0 + l * dphi);
