@@ -8,7 +8,6 @@
 #include "cvg_bench/core/errors.h"
 #include "cvg_bench/core/simd_vector4.h"
 
-
 namespace cvg_bench {
 namespace {
 

@@ -9,9 +9,9 @@ namespace {
 
 const std::vector<std::pair<std::string, std::function<ModelTermPtr()>>>& registry() {
   static const std::vector<std::pair<std::string, std::function<ModelTermPtr()>>> r = {
-      {"linear", makeLinearDefectTerm},        {"controls", makeControlTerm},
-      {"xi", makeCubicStiffnessTerm},          {"kappa", makeQuinticStiffnessTerm},
-      {"gamma_nl", makeNonlinearDampingTerm},  {"cm_rate", makeFrequencyDriftTerm},
+      {"linear", makeLinearDefectTerm},       {"controls", makeControlTerm},
+      {"xi", makeCubicStiffnessTerm},         {"kappa", makeQuinticStiffnessTerm},
+      {"gamma_nl", makeNonlinearDampingTerm}, {"cm_rate", makeFrequencyDriftTerm},
       {"xi_diff", makeAxisCubicMismatchTerm},
   };
   return r;

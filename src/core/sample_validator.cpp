@@ -7,7 +7,6 @@
 #include "cvg_bench/core/errors.h"
 #include "cvg_bench/core/simd_vector4.h"
 
-
 namespace cvg_bench {
 
 std::map<std::string, uint64_t> SampleCounters::asMap() const {

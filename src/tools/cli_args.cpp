@@ -45,7 +45,9 @@ CliArgs::CliArgs(const std::vector<std::string>& argv, const std::set<std::strin
   }
 }
 
-bool CliArgs::has(const std::string& name) const { return values_.count(name) > 0; }
+bool CliArgs::has(const std::string& name) const {
+  return values_.count(name) > 0;
+}
 
 std::string CliArgs::get(const std::string& name, const std::string& fallback) const {
   auto it = values_.find(name);
@@ -67,7 +69,8 @@ long CliArgs::getInt(const std::string& name, long fallback) const {
   const std::string s = get(name);
   char* end = nullptr;
   const long v = std::strtol(s.c_str(), &end, 10);
-  if (s.empty() || *end != '\0') throw InputError("option --" + name + " needs an integer, got '" + s + "'");
+  if (s.empty() || *end != '\0')
+    throw InputError("option --" + name + " needs an integer, got '" + s + "'");
   return v;
 }
 

@@ -21,7 +21,7 @@ struct ParameterFile {
   ParameterValues values;
   std::vector<std::string> cov_names;  ///< empty when the file has no covariance
   Eigen::MatrixXd covariance;
-  int dof = 0;             ///< degrees of freedom for Student-t (0: normal quantile)
+  int dof = 0;  ///< degrees of freedom for Student-t (0: normal quantile)
   double confidence = 0.95;
 };
 ParameterFile readParameterFile(const std::string& path);

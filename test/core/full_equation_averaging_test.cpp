@@ -11,8 +11,8 @@
 namespace cvg_bench {
 namespace {
 
-const ParameterValues kTruth = {{"gamma", 0.5}, {"nu", 0.3},  {"b_c", 0.1}, {"b_s", -0.05},
-                                {"c_m", 0.4},   {"n", 0.1},   {"h_c", 0.3}, {"h_s", -0.2},
+const ParameterValues kTruth = {{"gamma", 0.5}, {"nu", 0.3},    {"b_c", 0.1}, {"b_s", -0.05},
+                                {"c_m", 0.4},   {"n", 0.1},     {"h_c", 0.3}, {"h_s", -0.2},
                                 {"xi", 0.6},    {"kappa", -0.2}};
 
 struct Deviation {
@@ -43,7 +43,8 @@ Deviation compareFullWithAveraged(double omega, double duration_s) {
     for (int j = 0; j < steps_per_period; ++j) {
       const double ph = omega * t;
       const double w = 2.0 / steps_per_period;
-      acc += w * V4(x[0] * std::cos(ph), x[0] * std::sin(ph), x[2] * std::cos(ph), x[2] * std::sin(ph));
+      acc += w *
+             V4(x[0] * std::cos(ph), x[0] * std::sin(ph), x[2] * std::cos(ph), x[2] * std::sin(ph));
       const V4 k1 = fast_rhs(t, x), k2 = fast_rhs(t + h / 2, x + h / 2 * k1);
       const V4 k3 = fast_rhs(t + h / 2, x + h / 2 * k2), k4 = fast_rhs(t + h, x + h * k3);
       x += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);

@@ -1,4 +1,5 @@
-// Every term's averaged columns equal the first-harmonic projection of its fast force, by quadrature:
+// Every term's averaged columns equal the first-harmonic projection of its fast force, by
+// quadrature:
 //   2 q1' = -(2/w) <F_f sin wt>, 2 p1' = (2/w) <F_f cos wt>, likewise (q2, p2) from F_g,
 // with f = p1 sin wt + q1 cos wt, f' = w (p1 cos wt - q1 sin wt) (2.4). This checks the paper's
 // (2.5)/(3.2) and our extension terms against the full equations (2.3)/(3.1) term by term.
@@ -84,13 +85,12 @@ TEST(ModelTermAveraging, QuinticColumnIsTwiceThePrintedK5K7K8) {
                         p1 * (5 * std::pow(p2, 4) + 6 * p2 * p2 * q1 * q1 + 5 * std::pow(q1, 4) +
                               6 * (p2 * p2 + q1 * q1) * q2 * q2 + std::pow(q2, 4))) /
                       16;
-    const double k7 =
-        -(p2 * (5 * std::pow(p1 * p1 + p2 * p2, 2) + 2 * (3 * p1 * p1 + p2 * p2) * q1 * q1 +
-                std::pow(q1, 4)) +
-          4 * p1 * q1 * (p1 * p1 + 3 * p2 * p2 + q1 * q1) * q2 +
-          2 * p2 * (3 * p1 * p1 + 5 * p2 * p2 + 3 * q1 * q1) * q2 * q2 +
-          4 * p1 * q1 * std::pow(q2, 3) + 5 * p2 * std::pow(q2, 4)) /
-        16;
+    const double k7 = -(p2 * (5 * std::pow(p1 * p1 + p2 * p2, 2) +
+                              2 * (3 * p1 * p1 + p2 * p2) * q1 * q1 + std::pow(q1, 4)) +
+                        4 * p1 * q1 * (p1 * p1 + 3 * p2 * p2 + q1 * q1) * q2 +
+                        2 * p2 * (3 * p1 * p1 + 5 * p2 * p2 + 3 * q1 * q1) * q2 * q2 +
+                        4 * p1 * q1 * std::pow(q2, 3) + 5 * p2 * std::pow(q2, 4)) /
+                      16;
     const double k8 = (4 * std::pow(p1, 3) * p2 * q1 + std::pow(p1, 4) * q2 +
                        2 * p1 * p1 * q2 * (3 * (p2 * p2 + q1 * q1) + q2 * q2) +
                        4 * p1 * p2 * q1 * (p2 * p2 + q1 * q1 + 3 * q2 * q2) +

@@ -1,12 +1,13 @@
 // Orbit elements (5.2) both ways, and (5.7)-(5.10) (with NOTES.md corrections 4-5) against the
 // averaged model (2.5) mapped through (5.2) by the chain rule at random states away from r^2 = k^2.
+#include "cvg_bench/core/orbit_elements.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
 #include "cvg_bench/core/errors.h"
-#include "cvg_bench/core/orbit_elements.h"
 
 namespace cvg_bench {
 namespace {
@@ -30,8 +31,8 @@ Eigen::Vector4d orbitVector(const Eigen::Vector4d& q) {
 }
 
 TEST(OrbitElements, OrbitRatesEqualAveragedModelThroughChainRule) {
-  const ParameterValues p = {{"gamma", 0.9}, {"nu", 0.4},  {"b_c", 0.3}, {"b_s", -0.2},
-                             {"c_m", 0.7},   {"n", 0.25},  {"h_c", -0.5}, {"h_s", 0.35},
+  const ParameterValues p = {{"gamma", 0.9}, {"nu", 0.4},    {"b_c", 0.3},  {"b_s", -0.2},
+                             {"c_m", 0.7},   {"n", 0.25},    {"h_c", -0.5}, {"h_s", 0.35},
                              {"xi", 1.3},    {"kappa", -0.6}};
   const ResonatorModel model("xi+kappa", ExperimentMode::kFreeDecay);
   const Eigen::VectorXd z = model.parameterVector(p);
@@ -42,8 +43,7 @@ TEST(OrbitElements, OrbitRatesEqualAveragedModelThroughChainRule) {
     const Eigen::Vector4d q = slowFromOrbit(e);
     const Eigen::Vector4d qdot = model.slowDerivative(q, {}, z);
     const double h = 1e-6;
-    const Eigen::Vector4d chain =
-        (orbitVector(q + h * qdot) - orbitVector(q - h * qdot)) / (2 * h);
+    const Eigen::Vector4d chain = (orbitVector(q + h * qdot) - orbitVector(q - h * qdot)) / (2 * h);
     const OrbitRates o = orbitRates(e, p);
     EXPECT_NEAR(o.r_dot, chain[0], 1e-7) << "r' (5.7)";
     EXPECT_NEAR(o.k_dot, chain[1], 1e-7) << "k' (5.8)";

@@ -20,7 +20,8 @@ TEST(SingleModeClosedForm, CubicGivesMinusThreeQuartersXiP1Cubed) {
 TEST(SingleModeClosedForm, QuinticGivesMinusFiveEighthsKappaP1ToTheFifth) {
   ResonatorModel m("kappa", ExperimentMode::kFreeDecay);
   const double p1 = 0.9, kappa = -1.7;
-  const Eigen::Vector4d rate = m.slowDerivative({0, p1, 0, 0}, {}, m.parameterVector({{"kappa", kappa}}));
+  const Eigen::Vector4d rate =
+      m.slowDerivative({0, p1, 0, 0}, {}, m.parameterVector({{"kappa", kappa}}));
   EXPECT_NEAR(2 * rate[0], -0.625 * kappa * std::pow(p1, 5), 1e-14);
   EXPECT_NEAR(rate[1], 0.0, 1e-14);
 }

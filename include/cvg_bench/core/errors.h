@@ -1,6 +1,7 @@
-// Error types of the core. Bad input (files, options, parameters) is an InputError; an analysis that
-// ran but cannot give an answer (rank deficiency, no convergence) is an AnalysisError. The offline
-// tool maps them to exit status 2 and 1; nodes turn them into success=false with the message.
+// Error types of the core. Bad input (files, options, parameters) is an InputError; an analysis
+// that ran but cannot give an answer (rank deficiency, no convergence) is an AnalysisError. The
+// offline tool maps them to exit status 2 and 1; nodes turn them into success=false with the
+// message.
 #pragma once
 
 #include <stdexcept>

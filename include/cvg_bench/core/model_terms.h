@@ -17,7 +17,8 @@ ModelTermPtr makeQuinticStiffnessTerm();
 ModelTermPtr makeNonlinearDampingTerm();
 /// `cm_rate`: natural frequency drifting linearly in time, c_m(t) = c_m + cm_rate t.
 ModelTermPtr makeFrequencyDriftTerm();
-/// `xi_diff`: unequal cubic stiffness of the two axes, +xi_diff N f in the f equation, -xi_diff N g in g.
+/// `xi_diff`: unequal cubic stiffness of the two axes, +xi_diff N f in the f equation, -xi_diff N g
+/// in g.
 ModelTermPtr makeAxisCubicMismatchTerm();
 
 }  // namespace cvg_bench

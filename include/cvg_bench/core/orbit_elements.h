@@ -21,8 +21,8 @@ struct OrbitElements {
 Eigen::Vector4d slowFromOrbit(const OrbitElements& e);
 
 /// Inverse of (5.2) with the convention r >= |k|, r >= 0:
-///   (r^2 - k^2) cos 4 theta = q1^2 + p1^2 - q2^2 - p2^2,  (r^2 - k^2) sin 4 theta = 2 (q1 q2 + p1 p2),
-///   r^2 + k^2 = |q|^2,  r k = q1 p2 - p1 q2.
+///   (r^2 - k^2) cos 4 theta = q1^2 + p1^2 - q2^2 - p2^2,  (r^2 - k^2) sin 4 theta = 2 (q1 q2 + p1
+///   p2), r^2 + k^2 = |q|^2,  r k = q1 p2 - p1 q2.
 /// At r = |k| (a travelling wave) theta is undefined and 0 is returned.
 OrbitElements orbitFromSlow(const Eigen::Vector4d& q);
 
