@@ -8,7 +8,7 @@ PACKAGES=(
   catkin python3-catkin-pkg ros-core-dev ros-message-generation ros-message-runtime
   ros-std-msgs ros-std-srvs ros-geometry-msgs ros-diagnostic-msgs
   librosbag-dev python3-rosbag librostest-dev python3-rostest python3-rospy python3-roslib
-  python3-diagnostic-msgs
+  python3-diagnostic-msgs python3-tf2-ros
   libtf2-dev libtf2-ros-dev libtf2-geometry-msgs-dev libdiagnostic-updater-dev
   libeigen3-dev libceres-dev libboost-dev libboost-math-dev libyaml-cpp-dev nlohmann-json3-dev
   libgtest-dev googletest libbenchmark-dev
