@@ -41,6 +41,9 @@ FastSimulator::FastSimulator(const ResonatorModel& model, const Eigen::VectorXd&
   const auto problems = options.validate();
   if (!problems.empty()) throw InputError("fast simulator: " + problems.front());
   max_step_ = 2.0 * M_PI / (w_ * options.steps_per_period);
+  inv_w_ = 1.0 / w_;
+  detune_over_w_ = (w_ * w_ - omega_ * omega_) * inv_w_;
+  pumping_active_ = pumping_.active();
   for (const auto& term : model_.terms()) term_columns_.push_back(term->numParameters());
 }
 
@@ -52,9 +55,22 @@ Eigen::Vector2d FastSimulator::modelForce(const FastState& s, const FastContext&
     terms[i]->fastColumns(s, ctx, cols.middleCols(offset, term_columns_[i]));
     offset += term_columns_[i];
   }
-  Eigen::Vector2d force = Eigen::Vector2d::Zero();
-  for (int j = 0; j < offset; ++j) force += cols.col(j) * z_[j];
-  return force;
+  // cols * z in registers, two independent chains per row (no store-reload per column).
+  const double* a = cols.data();
+  const double* z = z_.data();
+  double f0 = 0.0, g0 = 0.0, f1 = 0.0, g1 = 0.0;
+  int j = 0;
+  for (; j + 1 < offset; j += 2) {
+    f0 += a[2 * j] * z[j];
+    g0 += a[2 * j + 1] * z[j];
+    f1 += a[2 * j + 2] * z[j + 1];
+    g1 += a[2 * j + 3] * z[j + 1];
+  }
+  if (j < offset) {
+    f0 += a[2 * j] * z[j];
+    g0 += a[2 * j + 1] * z[j];
+  }
+  return Eigen::Vector2d(f0 + f1, g0 + g1);
 }
 
 void FastSimulator::reset(const Eigen::Vector4d& x, double t_s) {
@@ -84,16 +100,26 @@ Eigen::Vector4d FastSimulator::rhs(double t, const Eigen::Vector4d& x, double c,
   // The reference runs at W = omega0, the drive frequency: (c, s) are the drive phase's cos, sin.
   const FastContext ctx{omega_, w_ * t, t, mu_, s, c};
   Eigen::Vector2d force = modelForce(st, ctx);
-  if (pumping_.active()) force += pumping_.force(st.f, st.g, w_ * t, omega_);
-  const double detune = w_ * w_ - omega_ * omega_, inv_w = 1.0 / w_;
-  const double gf = (force[0] + detune * st.f) * inv_w, gg = (force[1] + detune * st.g) * inv_w;
+  if (pumping_active_) force += pumping_.force(st.f, st.g, w_ * t, omega_);
+  const double gf = force[0] * inv_w_ + detune_over_w_ * st.f;
+  const double gg = force[1] * inv_w_ + detune_over_w_ * st.g;
   return Eigen::Vector4d(-gf * s, gf * c, -gg * s, gg * c);
 }
 
 void FastSimulator::step(double h) {
   const double t0 = t_, tm = t_ + 0.5 * h, t1 = t_ + h;
-  // Phase W t at the start from t (no drift); mid and end by rotation through W h / 2.
-  const double c0 = std::cos(w_ * t0), s0 = std::sin(w_ * t0);
+  // Phase W t at the start: carried over from the previous step's end by rotation when the step
+  // continues it, recomputed from t every kPhaseResync steps (rounding drift stays ~1e-15 rad).
+  double c0, s0;
+  if (t0 == phase_t_ && phase_steps_ < kPhaseResync) {
+    c0 = phase_cos_;
+    s0 = phase_sin_;
+    ++phase_steps_;
+  } else {
+    c0 = std::cos(w_ * t0);
+    s0 = std::sin(w_ * t0);
+    phase_steps_ = 0;
+  }
   if (h != half_step_of_) {
     half_step_of_ = h;
     half_cos_ = std::cos(0.5 * w_ * h);
@@ -107,6 +133,9 @@ void FastSimulator::step(double h) {
   const Eigen::Vector4d k4 = rhs(t1, x_ + h * k3, c1, s1);
   x_ += (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   t_ = t1;
+  phase_t_ = t1;
+  phase_cos_ = c1;
+  phase_sin_ = s1;
 }
 
 void FastSimulator::advanceTo(double t_end_s) {
@@ -118,7 +147,8 @@ void FastSimulator::advanceTo(double t_end_s) {
   const double h = span / n, t0 = t_;
   for (long k = 0; k < n; ++k) {
     step(h);
-    t_ = t0 + (k + 1) * h;  // no accumulated rounding in the phase W t
+    t_ = t0 + (k + 1) * h;  // no accumulated rounding in t
+    phase_t_ = t_;          // the carried phase belongs to this grid time (within an ulp)
   }
   t_ = t_end_s;
 }
@@ -140,6 +170,7 @@ void FastSimulator::sampleRaw(double rate_hz, size_t n, RawRecord& out) {
     for (long j = 0; j < m; ++j) {
       step(h);
       t_ = t0 + k * dt + (j + 1) * h;
+      phase_t_ = t_;
     }
   }
   t_ = t0 + n * dt;

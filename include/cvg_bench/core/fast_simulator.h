@@ -13,6 +13,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -87,10 +88,18 @@ class FastSimulator {
   double omega_, w_, mu_;
   ParametricPumping pumping_;
   double max_step_;
+  double inv_w_ = 1.0;           ///< 1 / W [s]
+  double detune_over_w_ = 0.0;   ///< (W^2 - omega^2) / W [rad/s]
+  bool pumping_active_ = false;  ///< pumping_.active(), cached
   Eigen::Vector4d x_ = Eigen::Vector4d::Zero();
   double t_ = 0.0;
   /// cos, sin of W h / 2 for the last step length h (cached: steps mostly have one length).
   double half_step_of_ = -1.0, half_cos_ = 1.0, half_sin_ = 0.0;
+  /// cos, sin of W t at t = phase_t_ (the end of the last step), and the steps since they were
+  /// last computed from t (carried by rotation in between; NaN time = none).
+  static constexpr int kPhaseResync = 32;
+  double phase_t_ = std::numeric_limits<double>::quiet_NaN(), phase_cos_ = 1.0, phase_sin_ = 0.0;
+  int phase_steps_ = 0;
 };
 
 }  // namespace cvg_bench
