@@ -47,7 +47,13 @@ FastSimulator::FastSimulator(const ResonatorModel& model, const Eigen::VectorXd&
   for (const auto& term : model_.terms()) term_columns_.push_back(term->numParameters());
 }
 
-Eigen::Vector2d FastSimulator::modelForce(const FastState& s, const FastContext& ctx) const {
+// Not vectorized on purpose: the terms have just written cols entry by entry, and a 16-byte load
+// spanning two 8-byte stores cannot be store-forwarded (a stall per column pair).
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-vectorize")))
+#endif
+Eigen::Vector2d
+FastSimulator::modelForce(const FastState& s, const FastContext& ctx) const {
   Eigen::Matrix<double, 2, Eigen::Dynamic, 0, 2, kMaxModelParameters> cols(2, z_.size());
   int offset = 0;
   const auto& terms = model_.terms();
