@@ -59,9 +59,13 @@ class ControlTerm : public ModelTerm {
     const double sn = given ? c.drive_sin : std::sin(c.drive_phase_rad);
     const double cs = given ? c.drive_cos : std::cos(c.drive_phase_rad);
     const double af = w * (1 + 3 * c.mu * s.f * s.f), ag = w * (1 + 3 * c.mu * s.g * s.g);
-    cols.setZero();
+    // u1, u2 drive f; u3, u4 drive g (entries set one by one: cheaper than zeroing the block).
     cols(0, 0) = -af * sn;
     cols(0, 1) = af * cs;
+    cols(0, 2) = 0.0;
+    cols(0, 3) = 0.0;
+    cols(1, 0) = 0.0;
+    cols(1, 1) = 0.0;
     cols(1, 2) = -ag * sn;
     cols(1, 3) = ag * cs;
   }
