@@ -144,6 +144,7 @@ void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
         window_end_ = stamp;
         window_samples_ = static_cast<uint32_t>(rls_->numBlocks() + 2);
         have_estimate_ = true;
+        axes_pending_ = true;
         last_rls_publish_wall_ = now;
         publishEstimate();
       }
@@ -214,6 +215,7 @@ void IdentifierNode::identifyNow(const IdentificationOptions& options) {
   window_end_ = stamps_.back();
   window_samples_ = static_cast<uint32_t>(have);
   have_estimate_ = true;
+  axes_pending_ = true;
   new_data_since_identify_ = false;
   if (e.rank < e.n_params)
     ROS_WARN("identifier: %s", summary(e, have).c_str());
@@ -273,10 +275,11 @@ void IdentifierNode::publishFrames() {
   if (!have_estimate_ && !have_latest_) return;
   const ros::Time stamp = have_latest_ ? latest_stamp_ : window_end_;
   const ros::WallTime now = ros::WallTime::now();
-  // tf2 rejects repeated stamps; 20 Hz is plenty for rviz.
-  if (stamp == last_tf_stamp_ || (now - last_tf_wall_).toSec() < 0.05) return;
-  last_tf_stamp_ = stamp;
-  last_tf_wall_ = now;
+  // tf2 rejects a repeated stamp per child frame; 20 Hz is plenty for rviz. A new estimate's axis
+  // frames are sent at once, even at the stamp the wave pattern was last sent with.
+  const bool repeated = stamp == last_tf_stamp_;
+  const bool throttled = (now - last_tf_wall_).toSec() < 0.05;
+  if (!(have_estimate_ && axes_pending_) && (repeated || throttled)) return;
   std::vector<geometry_msgs::TransformStamped> frames;
   const std::string& parent = options_.frame_id;
   const std::string& prefix = options_.child_frame_prefix;
@@ -284,7 +287,14 @@ void IdentifierNode::publishFrames() {
     const DefectAxes axes = defectAxes(valuesOf(estimate_));
     frames.push_back(rotationAboutZ(parent, prefix + "stiffness_axis", axes.alpha, stamp));
     frames.push_back(rotationAboutZ(parent, prefix + "damping_axis", axes.beta, stamp));
+    axes_pending_ = false;
   }
+  last_tf_wall_ = now;
+  if (repeated) {
+    tf_.sendTransform(frames);
+    return;
+  }
+  last_tf_stamp_ = stamp;
   if (have_latest_)
     frames.push_back(
         rotationAboutZ(parent, prefix + "wave_pattern", orbitFromSlow(latest_q_).theta, stamp));

@@ -119,12 +119,6 @@ class TfFrames(unittest.TestCase):
         expected = {"stiffness_axis": derived.alpha_rad, "damping_axis": derived.beta_rad}
         for child, angle in sorted(expected.items()):
             t = self.lookup(tf_buffer, child, min(5.0, left()))
-            if t is None and same_stamp(w.header.stamp, estimate.window_end):
-                # Known identifier_node race (publishFrames): when the last slow state's frames
-                # (wave_pattern only) already went out, the estimate's frames carry the same stamp
-                # and are dropped by the repeated-stamp guard, so the axes never appear.
-                self.skipTest("identifier_node dropped the axis frames (repeated-stamp guard in "
-                              "publishFrames after the last slow state): known node bug")
             self.assertIsNotNone(t, "no %s -> %s transform" % (PARENT, child))
             self.assertEqual(t.header.frame_id, PARENT)
             self.assertEqual(t.child_frame_id, child)

@@ -82,6 +82,8 @@ class IdentifierNode {
   uint64_t dropped_ = 0;
 
   bool have_estimate_ = false;
+  /// A new estimate whose axis frames have not been broadcast yet (sent even at a repeated stamp).
+  bool axes_pending_ = false;
   Estimate estimate_;
   ros::Time window_start_, window_end_;
   uint32_t window_samples_ = 0;
