@@ -64,13 +64,16 @@ void IncrementalQr::flush() {
     const double v0 = rjj - alpha;
     const double beta = 2.0 / (v0 * v0 + sigma);
     r_aug_(j, j) = alpha;
-    // Column by column (each is contiguous): w_c = beta (v0 R(j,c) + a'b_c), then update.
-    for (int c = j + 1; c < kk; ++c) {
-      auto b_col = buffer_.col(c).head(m);
-      const double w = beta * (v0 * r_aug_(j, c) + a_col.dot(b_col));
-      r_aug_(j, c) -= v0 * w;
-      b_col -= w * a_col;
-    }
+    // w = beta (v0 R(j, j+1:) + a'B) in one matrix-vector product (B read once, four columns per
+    // pass over a), then B -= a w'.
+    const int rest = kk - j - 1;
+    if (rest == 0) continue;
+    auto b_rest = buffer_.block(0, j + 1, m, rest);
+    Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxModelParameters + 1> w(rest);
+    w.noalias() = a_col.transpose() * b_rest;
+    w = beta * (v0 * r_aug_.row(j).tail(rest) + w);
+    r_aug_.row(j).tail(rest) -= v0 * w;
+    b_rest.noalias() -= a_col * w;
   }
   buffered_ = 0;
 }
