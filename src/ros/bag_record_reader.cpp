@@ -69,6 +69,15 @@ std::string stampText(const ros::Time& t) {
   return s.str();
 }
 
+/// The `# omega:` metadata line a CSV record would carry, at full precision (when omega is known).
+void setOmegaMetadata(double omega_rad_s, std::map<std::string, std::string>* metadata) {
+  if (!(omega_rad_s > 0.0)) return;
+  std::ostringstream s;
+  s.precision(17);
+  s << omega_rad_s;
+  (*metadata)["omega"] = s.str();
+}
+
 /// Which topic and kind to read.
 std::pair<std::string, RecordKind> chooseTopic(const std::string& path,
                                                const std::map<std::string, TopicInfo>& topics,
@@ -146,12 +155,7 @@ void readSlow(const rosbag::Bag& bag, const std::string& path, const std::string
                         : 0.0;
   rec.metadata["mode"] = "free_decay";
   rec.metadata["stamp_origin"] = stampText(origin);
-  if (rec.omega_rad_s > 0.0) {
-    std::ostringstream s;
-    s.precision(17);
-    s << rec.omega_rad_s;
-    rec.metadata["omega"] = s.str();
-  }
+  setOmegaMetadata(rec.omega_rad_s, &rec.metadata);
   rec.source = path;
 }
 
@@ -173,12 +177,7 @@ void readSweep(const rosbag::Bag& bag, const std::string& path, const std::strin
   }
   rec.metadata["mode"] = "forced";
   rec.metadata["stamp_origin"] = stampText(msgs.front()->header.stamp);
-  if (rec.omega_rad_s > 0.0) {
-    std::ostringstream s;
-    s.precision(17);
-    s << rec.omega_rad_s;
-    rec.metadata["omega"] = s.str();
-  }
+  setOmegaMetadata(rec.omega_rad_s, &rec.metadata);
   rec.source = path;
 }
 
@@ -248,12 +247,7 @@ void readRaw(const rosbag::Bag& bag, const std::string& path, const std::string&
   if (driven) rec.extra["omega0"] = omega0;
   rec.metadata["mode"] = driven ? "forced" : "free_decay";
   rec.metadata["stamp_origin"] = stampText(origin);
-  if (rec.omega_rad_s > 0.0) {
-    std::ostringstream s;
-    s.precision(17);
-    s << rec.omega_rad_s;
-    rec.metadata["omega"] = s.str();
-  }
+  setOmegaMetadata(rec.omega_rad_s, &rec.metadata);
   rec.source = path;
 }
 
