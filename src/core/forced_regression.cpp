@@ -16,17 +16,23 @@ void validateSweepRecord(const SweepRecord& record) {
     throw InputError(src + ": a forced sweep needs at least " + std::to_string(kMinSweepPoints) +
                      " stationary points (16 equations of (3.5)), got " +
                      std::to_string(record.size()));
+  // The message is built only for the offending point (10^6-point sweeps are validated per call).
   for (size_t j = 0; j < record.size(); ++j) {
-    const std::string at = src + ": point " + std::to_string(j);
     if (!(std::isfinite(record.omega0_rad_s[j]) && record.omega0_rad_s[j] > 0.0))
-      throw InputError(at + ": omega0 must be finite and > 0");
-    if (!record.q[j].allFinite()) throw InputError(at + ": q is not finite");
+      throw InputError(src + ": point " + std::to_string(j) + ": omega0 must be finite and > 0");
+    if (!record.q[j].allFinite())
+      throw InputError(src + ": point " + std::to_string(j) + ": q is not finite");
   }
 }
 
 void forEachForcedBlock(const ResonatorModel& model, const SweepRecord& record, double omega_rad_s,
                         double mu, const RegressionVisitor& visit) {
   validateSweepRecord(record);
+  forEachValidatedForcedBlock(model, record, omega_rad_s, mu, visit);
+}
+
+void forEachValidatedForcedBlock(const ResonatorModel& model, const SweepRecord& record,
+                                 double omega_rad_s, double mu, const RegressionVisitor& visit) {
   requirePositive(omega_rad_s, "omega (natural frequency)");
   requireFinite(mu, "mu");
   RegressionBlockMatrix d(4, model.numParameters());

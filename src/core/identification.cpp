@@ -436,12 +436,11 @@ Estimate identifyFreeDecay(const std::vector<SlowRecord>& records,
   return identifyFreeDecayRecords(pointers, options);
 }
 
-Estimate identifyForced(const SweepRecord& record, const IdentificationOptions& options) {
-  return identifyForced(std::vector<SweepRecord>{record}, options);
-}
+namespace {
 
-Estimate identifyForced(const std::vector<SweepRecord>& records,
-                        const IdentificationOptions& options) {
+/// Forced sweeps given by pointer (the single-record overload copies nothing).
+Estimate identifyForcedRecords(const std::vector<const SweepRecord*>& records,
+                               const IdentificationOptions& options) {
   throwIfInvalid(options);
   if (records.empty()) throw InputError("no sweep record given");
   const ResonatorModel model(options.model, ExperimentMode::kForced);
@@ -457,11 +456,11 @@ Estimate identifyForced(const std::vector<SweepRecord>& records,
   info.model = model.spec();
   info.names = model.parameterNames();
   info.max_lag_blocks = 0;
-  info.omega_rad_s = resolveOmega(options.omega_rad_s, records[0].omega_rad_s, true,
-                                  records[0].source.empty() ? "sweep" : records[0].source);
-  for (const auto& r : records) {
-    validateSweepRecord(r);
-    info.num_clusters += static_cast<long>(r.size());
+  info.omega_rad_s = resolveOmega(options.omega_rad_s, records[0]->omega_rad_s, true,
+                                  records[0]->source.empty() ? "sweep" : records[0]->source);
+  for (const SweepRecord* r : records) {
+    validateSweepRecord(*r);
+    info.num_clusters += static_cast<long>(r->size());
   }
   info.notes.push_back(
       "stationary equations (3.4): y_j = ((omega0^2 - omega^2)/omega0) (p1, -q1, "
@@ -472,11 +471,24 @@ Estimate identifyForced(const std::vector<SweepRecord>& records,
       "item 15); --method ceres removes it");
   const BlockStream stream = [&](const BlockSink& sink) {
     for (size_t r = 0; r < records.size(); ++r) {
-      forEachForcedBlock(model, records[r], info.omega_rad_s, options.mu,
-                         [&](const RegressionBlock& b) { sink(static_cast<int>(r), b); });
+      forEachValidatedForcedBlock(model, *records[r], info.omega_rad_s, options.mu,
+                                  [&](const RegressionBlock& b) { sink(static_cast<int>(r), b); });
     }
   };
   return runEstimator(stream, info, options);
+}
+
+}  // namespace
+
+Estimate identifyForced(const SweepRecord& record, const IdentificationOptions& options) {
+  return identifyForcedRecords({&record}, options);
+}
+
+Estimate identifyForced(const std::vector<SweepRecord>& records,
+                        const IdentificationOptions& options) {
+  std::vector<const SweepRecord*> pointers;
+  for (const auto& r : records) pointers.push_back(&r);
+  return identifyForcedRecords(pointers, options);
 }
 
 StackedSystem buildFreeDecaySystem(const std::vector<SlowRecord>& records,

@@ -19,4 +19,9 @@ void validateSweepRecord(const SweepRecord& record);
 void forEachForcedBlock(const ResonatorModel& model, const SweepRecord& record, double omega_rad_s,
                         double mu, const RegressionVisitor& visit);
 
+/// forEachForcedBlock for a record that already passed validateSweepRecord (batch identification
+/// streams a record twice and validates it once).
+void forEachValidatedForcedBlock(const ResonatorModel& model, const SweepRecord& record,
+                                 double omega_rad_s, double mu, const RegressionVisitor& visit);
+
 }  // namespace cvg_bench
