@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/block_gram_accumulator.h"
 #include "cvg_bench/core/derived_uncertainty.h"
 #include "cvg_bench/core/errors.h"
 #include "cvg_bench/core/forced_regression.h"
@@ -181,9 +182,7 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
       a.u.resize(4, k);
       a.v.resize(4, k);
     }
-    constexpr int kBatch = 64;
-    Eigen::MatrixXd wbuf(k, 4 * kBatch), meat = Eigen::MatrixXd::Zero(k, k);
-    int in_buf = 0;
+    BlockGramAccumulator meat(k);
     double tr_a = 0.0, lag2 = 0.0;
     Eigen::Matrix4d g;
     RegressionBlockMatrix x(4, k);
@@ -194,11 +193,7 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
       model.regressorJacobian(q, jctx, z, g);
       const Eigen::Matrix4d gt = g.transpose();
       for (int c = 0; c < k; ++c) x.col(c) = a.u.col(c) - gt * a.v.col(c);  // fixed-size 4x4
-      wbuf.middleCols<4>(4 * in_buf) = x.transpose();
-      if (++in_buf == kBatch) {
-        meat.selfadjointView<Eigen::Lower>().rankUpdate(wbuf);
-        in_buf = 0;
-      }
+      meat.add(x);                                                          // x = W_m'
       tr_a += 4.0 * a.s2 - 2.0 * a.sw * g.trace() + a.w2 * g.squaredNorm();
     };
     Eigen::Vector4d r_hist[2] = {Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
@@ -239,10 +234,8 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
         in_record = 0;
       }
     });
-    if (in_buf > 0) meat.selfadjointView<Eigen::Lower>().rankUpdate(wbuf.leftCols(4 * in_buf));
-    meat.triangularView<Eigen::StrictlyUpper>() = meat.transpose();
     const double sigma_q2 = tr_a > 0.0 ? rss / tr_a * static_cast<double>(n) / dof_paper : 0.0;
-    honest = sigma_q2 * c * meat * c;
+    honest = sigma_q2 * c * meat.sum() * c;
     e.interval_method =
         "errors-in-variables covariance of the differenced regression: sigma_q^2 C (sum_m W_m "
         "W_m') C, W_m = sum_i D-bar_i' de_i/dq_m (samples shared by neighbouring equations of "
@@ -252,24 +245,26 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
                       " (white noise on q predicts -0.5)");
   } else {
     // Sweep points are independent: per-point (cluster) sandwich from the residuals.
-    // sum of sc sc' with sc = D_j' r_j, folded in 64 points at a time (symmetric rank update).
-    constexpr int kBatch = 64;
-    Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(k, k), scores(k, kBatch);
-    int in_buf = 0;
+    // sum of sc sc' with sc = D_j' r_j: four points' scores are the rows of one Gram block.
+    BlockGramAccumulator meat(k);
+    RegressionBlockMatrix scores = RegressionBlockMatrix::Zero(4, k);
+    int in_block = 0;
     stream([&](int, const RegressionBlock& b) {
       const Eigen::Vector4d r = b.y - (*b.d) * z;
       rss += r.squaredNorm();
-      scores.col(in_buf).noalias() = b.d->transpose() * r;
-      if (++in_buf == kBatch) {
-        meat.selfadjointView<Eigen::Lower>().rankUpdate(scores);
-        in_buf = 0;
+      scores.row(in_block).noalias() = r.transpose() * (*b.d);
+      if (++in_block == 4) {
+        meat.add(scores);
+        in_block = 0;
       }
     });
-    if (in_buf > 0) meat.selfadjointView<Eigen::Lower>().rankUpdate(scores.leftCols(in_buf));
-    meat.triangularView<Eigen::StrictlyUpper>() = meat.transpose();
+    if (in_block > 0) {
+      scores.bottomRows(4 - in_block).setZero();
+      meat.add(scores);
+    }
     const double g = static_cast<double>(std::max(2L, info.num_clusters));
     const double factor = g / (g - 1.0) * static_cast<double>(n - 1) / dof_paper;
-    honest = factor * c * meat * c;
+    honest = factor * c * meat.sum() * c;
     dof_honest = static_cast<int>(std::max(1L, info.num_clusters - 1));
     e.interval_method =
         "per-point (cluster) sandwich (D'D)^-1 D' Omega D (D'D)^-1, Omega block-diagonal from the "

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/householder_panel_update.h"
 
 namespace cvg_bench {
 namespace {
@@ -48,33 +49,15 @@ const Eigen::MatrixXd& IncrementalQr::rAug() {
   return r_aug_;
 }
 
-// Householder reflections on [R_aug; B]: column j's reflector has nonzeros only in row j of R_aug
-// and in the buffered rows B, so the cost is ~2 m k^2 for m buffered rows.
+// Householder reflections on [R_aug; B] (householder_panel_update.h): column j's reflector has
+// nonzeros only in row j of R_aug and in the buffered rows B, so the cost is ~2 m k^2 for m rows.
 void IncrementalQr::flush() {
   const int m = buffered_;
   if (m == 0) return;
-  const int kk = k_ + 1;
-  for (int j = 0; j < kk; ++j) {
-    const auto a_col = buffer_.col(j).head(m);
-    const double sigma = a_col.squaredNorm();
-    if (sigma == 0.0) continue;
-    const double rjj = r_aug_(j, j);
-    const double norm = std::sqrt(rjj * rjj + sigma);
-    const double alpha = rjj >= 0.0 ? -norm : norm;
-    const double v0 = rjj - alpha;
-    const double beta = 2.0 / (v0 * v0 + sigma);
-    r_aug_(j, j) = alpha;
-    // w = beta (v0 R(j, j+1:) + a'B) in one matrix-vector product (B read once, four columns per
-    // pass over a), then B -= a w'.
-    const int rest = kk - j - 1;
-    if (rest == 0) continue;
-    auto b_rest = buffer_.block(0, j + 1, m, rest);
-    Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, kMaxModelParameters + 1> w(rest);
-    w.noalias() = a_col.transpose() * b_rest;
-    w = beta * (v0 * r_aug_.row(j).tail(rest) + w);
-    r_aug_.row(j).tail(rest) -= v0 * w;
-    b_rest.noalias() -= a_col * w;
-  }
+  const int rows4 = (m + 3) / 4 * 4;  // zero rows change nothing
+  if (rows4 > m) buffer_.middleRows(m, rows4 - m).setZero();
+  householderPanelUpdate(r_aug_.data(), static_cast<int>(r_aug_.outerStride()), buffer_.data(),
+                         static_cast<int>(buffer_.outerStride()), rows4, k_ + 1);
   buffered_ = 0;
 }
 

@@ -49,6 +49,38 @@ TEST(LeastSquares, DependentColumnsGiveRankAndNullSpace) {
   EXPECT_THROW(solveLeastSquares(a, a.col(2), 0.0), InputError);
 }
 
+// The panel-blocked kernel for every model size (panels of 4 with tails of 1..3 columns), rows
+// arriving as 4-row blocks and as odd-sized row batches (zero-row padding), several buffer flushes:
+// R_aug' R_aug must equal [A y]'[A y] and R_aug must be upper triangular.
+TEST(LeastSquares, StreamingFactorReproducesTheGramMatrixForEveryModelSize) {
+  std::mt19937_64 gen(3);
+  std::normal_distribution<double> n01;
+  for (int k = 1; k <= kMaxModelParameters; ++k) {
+    const int rows = 4 * 150 + 7;
+    Eigen::MatrixXd a(rows, k);
+    Eigen::VectorXd y(rows);
+    for (int i = 0; i < rows; ++i) {
+      for (int j = 0; j < k; ++j) a(i, j) = n01(gen) * std::pow(2.0, j % 5);
+      y[i] = n01(gen);
+    }
+    if (k > 2) a.col(1).head(300).setZero();  // a column empty in the first flushes
+    IncrementalQr qr(k);
+    int i = 0;
+    for (; i + 4 <= 4 * 150; i += 4) {
+      const RegressionBlockMatrix d = a.middleRows(i, 4);
+      qr.addBlock(d, y.segment<4>(i));
+    }
+    qr.addRows(a.bottomRows(rows - i), y.tail(rows - i));
+    EXPECT_EQ(qr.numRows(), rows);
+    Eigen::MatrixXd ay(rows, k + 1);
+    ay << a, y;
+    const Eigen::MatrixXd gram = ay.transpose() * ay;
+    const Eigen::MatrixXd r = qr.rAug();
+    EXPECT_LT((r.transpose() * r - gram).norm(), 1e-12 * gram.norm()) << "k = " << k;
+    EXPECT_EQ(r.triangularView<Eigen::StrictlyLower>().toDenseMatrix().norm(), 0.0) << "k = " << k;
+  }
+}
+
 TEST(StudentT, QuantilesOfTheTables) {
   EXPECT_NEAR(studentQuantile(0.95, 10), 2.228139, 1e-6);
   EXPECT_NEAR(studentQuantile(0.95, 0), 1.959964, 1e-6);
