@@ -27,35 +27,60 @@ __attribute__((always_inline)) inline double dot(const double* x, const double* 
   return sum4(acc);
 }
 
-/// P reflectors (vectors a[0..P) in B, scalars v0, beta) applied to the columns [c_begin, c_end).
+/// P reflectors (vectors a[0..P) in B, scalars v0, beta) applied to NC adjacent columns from c
+/// (two columns share the loads of the reflector vectors).
+template <int P, int NC>
+__attribute__((always_inline)) inline void applyToColumns(const double* const* a, const double* v0,
+                                                          const double* beta,
+                                                          const double (*gram)[kPanel], double* r,
+                                                          int ldr, int row0, double* b, int ldb,
+                                                          int rows4, int c) {
+  double* bc[NC];
+  V4 acc[NC][P];
+  for (int n = 0; n < NC; ++n) {
+    bc[n] = b + static_cast<long>(c + n) * ldb;
+    for (int i = 0; i < P; ++i) acc[n][i] = V4{0.0, 0.0, 0.0, 0.0};
+  }
+  for (int k = 0; k < rows4; k += 4) {
+    V4 x[NC];
+    for (int n = 0; n < NC; ++n) x[n] = load4(bc[n] + k);
+    for (int i = 0; i < P; ++i) {
+      const V4 ai = load4(a[i] + k);
+      for (int n = 0; n < NC; ++n) acc[n][i] += ai * x[n];
+    }
+  }
+  double s[NC][P];
+  for (int n = 0; n < NC; ++n) {
+    double* rc = r + static_cast<long>(c + n) * ldr + row0;
+    for (int i = 0; i < P; ++i) {
+      double t = v0[i] * rc[i] + sum4(acc[n][i]);
+      for (int l = 0; l < i; ++l) t -= s[n][l] * gram[i][l];
+      s[n][i] = beta[i] * t;
+      rc[i] -= v0[i] * s[n][i];
+    }
+  }
+  for (int k = 0; k < rows4; k += 4) {
+    V4 x[NC];
+    for (int n = 0; n < NC; ++n) x[n] = load4(bc[n] + k);
+    for (int i = 0; i < P; ++i) {
+      const V4 ai = load4(a[i] + k);
+      for (int n = 0; n < NC; ++n) x[n] -= s[n][i] * ai;
+    }
+    for (int n = 0; n < NC; ++n) store4(bc[n] + k, x[n]);
+  }
+}
+
+/// The P reflectors applied to the columns [c_begin, c_end).
 template <int P>
 __attribute__((always_inline)) inline void applyPanel(const double* const* a, const double* v0,
                                                       const double* beta,
                                                       const double (*gram)[kPanel], double* r,
                                                       int ldr, int row0, double* b, int ldb,
                                                       int rows4, int c_begin, int c_end) {
-  for (int c = c_begin; c < c_end; ++c) {
-    double* bc = b + static_cast<long>(c) * ldb;
-    V4 acc[P];
-    for (int i = 0; i < P; ++i) acc[i] = V4{0.0, 0.0, 0.0, 0.0};
-    for (int k = 0; k < rows4; k += 4) {
-      const V4 x = load4(bc + k);
-      for (int i = 0; i < P; ++i) acc[i] += load4(a[i] + k) * x;
-    }
-    double s[P];
-    double* rc = r + static_cast<long>(c) * ldr + row0;
-    for (int i = 0; i < P; ++i) {
-      double t = v0[i] * rc[i] + sum4(acc[i]);
-      for (int l = 0; l < i; ++l) t -= s[l] * gram[i][l];
-      s[i] = beta[i] * t;
-      rc[i] -= v0[i] * s[i];
-    }
-    for (int k = 0; k < rows4; k += 4) {
-      V4 x = load4(bc + k);
-      for (int i = 0; i < P; ++i) x -= s[i] * load4(a[i] + k);
-      store4(bc + k, x);
-    }
-  }
+  int c = c_begin;
+  for (; c + 2 <= c_end; c += 2)
+    applyToColumns<P, 2>(a, v0, beta, gram, r, ldr, row0, b, ldb, rows4, c);
+  if (c < c_end) applyToColumns<P, 1>(a, v0, beta, gram, r, ldr, row0, b, ldb, rows4, c);
 }
 
 template <int P>

@@ -8,6 +8,7 @@
 #include "cvg_bench/core/derived_uncertainty.h"
 #include "cvg_bench/core/errors.h"
 #include "cvg_bench/core/forced_regression.h"
+#include "cvg_bench/core/free_decay_noise_propagation.h"
 #include "cvg_bench/core/free_decay_regression.h"
 #include "cvg_bench/core/identifiability.h"
 #include "cvg_bench/core/least_squares_solver.h"
@@ -159,43 +160,10 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
   Eigen::MatrixXd honest;
   int dof_honest = dof_paper;
   if (info.mode == ExperimentMode::kFreeDecay && info.resonator != nullptr) {
-    // Errors in variables, linearized in white sample noise eps_m (covariance sigma_q^2 I):
-    //   e_i = sum_m A_im eps_m,  A_i,i+1 = 2 I - w_i,i+1 G_i+1,  A_i,i = -w_ii G_i,
-    //   A_i,i-1 = -2 I - w_i,i-1 G_i-1,  G = d(D(q) z)/dq,  w the quadrature weights of D-bar_i;
-    // D' Omega D = sigma_q^2 sum_m W_m W_m',  W_m = sum_i D-bar_i' A_im (telescopes: small inside
-    // the record, O(1) at its ends); sigma_q^2 = RSS / sum ||A_im||_F^2 x n / (n - k).
-    // Per sample, W_m' = U_m - G_m' V_m with U_m = 2 (D-bar_{m-1} - D-bar_{m+1}) and
-    // V_m = sum_i w_im D-bar_i (4 x k each), so G_m (analytic, ResonatorModel::regressorJacobian)
-    // is evaluated once per sample; ||s I - w G||^2 = 4 s^2 - 2 s w tr G + w^2 ||G||^2.
-    const ResonatorModel& model = *info.resonator;
-    struct SampleTerms {
-      RegressionBlockMatrix u, v;
-      double s2 = 0.0, sw = 0.0, w2 = 0.0;  // sums of s^2, s w, w^2 over the sample's blocks
-      void clear() {
-        u.setZero();
-        v.setZero();
-        s2 = sw = w2 = 0.0;
-      }
-    };
-    SampleTerms acc[3];
-    for (auto& a : acc) {
-      a.u.resize(4, k);
-      a.v.resize(4, k);
-    }
-    BlockGramAccumulator meat(k);
-    double tr_a = 0.0, lag2 = 0.0;
-    Eigen::Matrix4d g;
-    RegressionBlockMatrix x(4, k);
-    SlowContext jctx;
-    // Sample complete: G at (q, t), W_m' into the batch, its share of sum ||A_im||^2.
-    auto finish = [&](SampleTerms& a, const Eigen::Vector4d& q, double t) {
-      jctx.t_s = t;
-      model.regressorJacobian(q, jctx, z, g);
-      const Eigen::Matrix4d gt = g.transpose();
-      for (int c = 0; c < k; ++c) x.col(c) = a.u.col(c) - gt * a.v.col(c);  // fixed-size 4x4
-      meat.add(x);                                                          // x = W_m'
-      tr_a += 4.0 * a.s2 - 2.0 * a.sw * g.trace() + a.w2 * g.squaredNorm();
-    };
+    // Errors in variables (free_decay_noise_propagation.h): D' Omega D = sigma_q^2 sum_m W_m W_m',
+    // sigma_q^2 = RSS / sum ||A_im||_F^2 x n / (n - k).
+    FreeDecayNoisePropagation propagation(*info.resonator, z);
+    double lag2 = 0.0;
     Eigen::Vector4d r_hist[2] = {Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
     long in_record = 0;
     stream([&](int, const RegressionBlock& b) {
@@ -206,36 +174,12 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
       if (in_record >= 2) lag2 += r.dot(r_hist[1]);
       r_hist[1] = r_hist[0];
       r_hist[0] = r;
-      // Block i = in_record + 1 of the record uses samples i-1, i, i+1 (slots by sample mod 3).
-      SampleTerms& prev = acc[in_record % 3];
-      SampleTerms& mid = acc[(in_record + 1) % 3];
-      SampleTerms& next = acc[(in_record + 2) % 3];
-      if (in_record == 0) {  // samples 0 and 1 of the record start here
-        prev.clear();
-        mid.clear();
-      }
-      prev.u -= 2.0 * d;
-      prev.v += b.weights[0] * d;
-      prev.s2 += 4.0;
-      prev.sw -= 2.0 * b.weights[0];
-      prev.w2 += b.weights[0] * b.weights[0];
-      mid.v += b.weights[1] * d;
-      mid.w2 += b.weights[1] * b.weights[1];
-      next.u = 2.0 * d;  // sample i+1 appears first here
-      next.v = b.weights[2] * d;
-      next.s2 = 4.0;
-      next.sw = 2.0 * b.weights[2];
-      next.w2 = b.weights[2] * b.weights[2];
-      finish(prev, b.q_prev, b.t_prev);  // sample i-1 appears in no later block
-      ++in_record;
-      if (b.last_in_record) {
-        finish(mid, b.q, b.abscissa);
-        finish(next, b.q_next, b.t_next);
-        in_record = 0;
-      }
+      propagation.add(b);
+      in_record = b.last_in_record ? 0 : in_record + 1;
     });
+    const double tr_a = propagation.noiseGain();
     const double sigma_q2 = tr_a > 0.0 ? rss / tr_a * static_cast<double>(n) / dof_paper : 0.0;
-    honest = sigma_q2 * c * meat.sum() * c;
+    honest = sigma_q2 * c * propagation.sensitivityGram() * c;
     e.interval_method =
         "errors-in-variables covariance of the differenced regression: sigma_q^2 C (sum_m W_m "
         "W_m') C, W_m = sum_i D-bar_i' de_i/dq_m (samples shared by neighbouring equations of "
