@@ -4,6 +4,7 @@
 #include <string>
 
 #include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/regression_block_ops.h"
 
 namespace cvg_bench {
 namespace {
@@ -86,7 +87,7 @@ void forEachValidatedFreeDecayBlock(const ResonatorModel& model, const SlowRecor
       b.weights[1] = 0.5 * (h0 + h1);
       b.weights[2] = 0.5 * h1;
     }
-    dbar = b.weights[0] * prev + b.weights[1] * mid + b.weights[2] * next;
+    weightedBlockSum(b.weights[0], prev, b.weights[1], mid, b.weights[2], next, dbar);
     b.y = 2.0 * (record.q[i + 1] - record.q[i - 1]);
     b.q = record.q[i];
     b.abscissa = record.t_s[i] - t0;

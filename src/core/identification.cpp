@@ -13,6 +13,7 @@
 #include "cvg_bench/core/identifiability.h"
 #include "cvg_bench/core/least_squares_solver.h"
 #include "cvg_bench/core/recursive_least_squares.h"
+#include "cvg_bench/core/regression_block_ops.h"
 #include "cvg_bench/core/student_t.h"
 
 namespace cvg_bench {
@@ -167,9 +168,7 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
     Eigen::Vector4d r_hist[2] = {Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
     long in_record = 0;
     stream([&](int, const RegressionBlock& b) {
-      const RegressionBlockMatrix& d = *b.d;
-      Eigen::Vector4d r = b.y;
-      for (int c = 0; c < k; ++c) r -= z[c] * d.col(c);
+      const Eigen::Vector4d r = blockResidual(*b.d, z, b.y);
       rss += r.squaredNorm();
       if (in_record >= 2) lag2 += r.dot(r_hist[1]);
       r_hist[1] = r_hist[0];
@@ -194,7 +193,7 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
     RegressionBlockMatrix scores = RegressionBlockMatrix::Zero(4, k);
     int in_block = 0;
     stream([&](int, const RegressionBlock& b) {
-      const Eigen::Vector4d r = b.y - (*b.d) * z;
+      const Eigen::Vector4d r = blockResidual(*b.d, z, b.y);
       rss += r.squaredNorm();
       scores.row(in_block).noalias() = r.transpose() * (*b.d);
       if (++in_block == 4) {

@@ -20,7 +20,7 @@ IncrementalQr::IncrementalQr(int num_params) : k_(num_params) {
     throw InputError("least squares needs 1.." + std::to_string(kMaxModelParameters) +
                      " parameters, got " + std::to_string(num_params));
   r_aug_ = Eigen::MatrixXd::Zero(k_ + 1, k_ + 1);
-  buffer_.resize(kBufferRows, k_ + 1);
+  buffer_.resize(kBufferRows + 8, k_ + 1);  // + 8: columns 2 kB apart would alias in the L1 cache
 }
 
 void IncrementalQr::addRows(const Eigen::Ref<const Eigen::MatrixXd>& a,
