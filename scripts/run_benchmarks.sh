@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # `make bench`: runs the Google Benchmarks (cvg_benchmarks, or $CVG_BENCHMARKS) and every NumPy
 # reference scripts/bench_numpy_*.py in the same run, and writes docs/benchmarks.md (machine, date,
-# table with C++/NumPy ratios matched by benchmark name). Raw results: build/bench/.
+# table with C++/NumPy ratios matched by benchmark name). Each C++ benchmark is repeated
+# CVG_BENCH_REPETITIONS times (default 5) and reported by its median, with the spread (coefficient
+# of variation): a shared or virtual machine varies by several per cent from run to run.
+# Raw results: build/bench/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -12,8 +15,10 @@ if [[ ! -x "$bench" ]]; then
 fi
 out="$root/build/bench"
 mkdir -p "$out"
-echo "run_benchmarks: $bench"
-"$bench" --benchmark_format=json --benchmark_out="$out/cpp.json" --benchmark_out_format=json \
+reps="${CVG_BENCH_REPETITIONS:-5}"
+echo "run_benchmarks: $bench ($reps repetitions)"
+"$bench" --benchmark_repetitions="$reps" --benchmark_report_aggregates_only=true \
+  --benchmark_format=json --benchmark_out="$out/cpp.json" --benchmark_out_format=json \
   > /dev/null
 : > "$out/numpy.jsonl"
 for script in scripts/bench_numpy_*.py; do
@@ -23,10 +28,10 @@ for script in scripts/bench_numpy_*.py; do
     echo "run_benchmarks: $script failed" >&2
   }
 done
-/usr/bin/python3 - "$out/cpp.json" "$out/numpy.jsonl" "$root/docs/benchmarks.md" <<'PY'
+/usr/bin/python3 - "$out/cpp.json" "$out/numpy.jsonl" "$root/docs/benchmarks.md" "$reps" <<'PY'
 import datetime, json, subprocess, sys
 
-cpp_path, numpy_path, md_path = sys.argv[1:4]
+cpp_path, numpy_path, md_path, REPS = sys.argv[1:5]
 cpp = json.load(open(cpp_path))
 numpy = {}
 for line in open(numpy_path):
@@ -59,15 +64,17 @@ lines = [
     "- Build: cvg_benchmarks in the project's Release build (-O3; hot kernels also cloned for "
     "x86-64-v3); single thread; items/s from CPU time (libbenchmark itself reports '%s')"
     % ctx.get("library_build_type", "?"),
+    "- Each C++ figure is the median of %s repetitions; cv = their coefficient of variation"
+    % REPS,
     "- NumPy references: scripts/bench_numpy_*.py run in the same session (/usr/bin/python3, "
     "numpy %s), matched by name" % subprocess.run(
         ["/usr/bin/python3", "-c", "import numpy; print(numpy.__version__)"],
         capture_output=True, text=True).stdout.strip(),
     "",
-    "| benchmark | C++ CPU time | C++ items/s | NumPy items/s | C++ / NumPy | counters |",
-    "|---|---|---|---|---|---|",
+    "| benchmark | C++ CPU time (median) | cv | C++ items/s | NumPy items/s | C++ / NumPy | counters |",
+    "|---|---|---|---|---|---|---|",
 ]
-STANDARD = {"name", "family_index", "per_family_instance_index", "run_name", "run_type",
+STANDARD = {"name", "aggregate_name", "aggregate_unit", "family_index", "per_family_instance_index", "run_name", "run_type",
             "repetitions", "repetition_index", "threads", "iterations", "real_time", "cpu_time",
             "time_unit", "items_per_second", "bytes_per_second"}
 
@@ -78,23 +85,31 @@ def counters(b):
             continue
         out.append("%s %s" % (k, si(v) if isinstance(v, (int, float)) else v))
     return ", ".join(out)
-for b in cpp.get("benchmarks", []):
-    if b.get("run_type") == "aggregate":
-        continue
-    name = b["name"]
+def aggregate(kind):
+    out = {}
+    for b in cpp.get("benchmarks", []):
+        if b.get("run_type") == "aggregate" and b.get("aggregate_name") == kind:
+            out[b["run_name"]] = dict(b, name=b["run_name"])
+        elif b.get("run_type") != "aggregate" and kind == "median":
+            out.setdefault(b["name"], b)  # a single repetition has no aggregates
+    return out
+
+by_name = aggregate("median")
+cv = aggregate("cv")
+for name, b in by_name.items():
     ips = b.get("items_per_second")
     ref = numpy.get(name)
     ratio = "%.0fx" % (ips / ref["items_per_second"]) if ips and ref else ""
-    lines.append("| %s | %.4g %s | %s | %s | %s | %s |" % (
-        name, b["cpu_time"], b.get("time_unit", ""), si(ips) if ips else "",
+    spread = "%.1f %%" % (100.0 * cv[name]["cpu_time"]) if name in cv else ""
+    lines.append("| %s | %.4g %s | %s | %s | %s | %s | %s |" % (
+        name, b["cpu_time"], b.get("time_unit", ""), spread, si(ips) if ips else "",
         si(ref["items_per_second"]) if ref else "", ratio, counters(b)))
-extra = [n for n in numpy if n not in {b["name"] for b in cpp.get("benchmarks", [])}]
+extra = [n for n in numpy if n not in by_name]
 for n in extra:
-    lines.append("| %s (NumPy only) | | | %s | |" % (n, si(numpy[n]["items_per_second"])))
+    lines.append("| %s (NumPy only) | | | | %s | | |" % (n, si(numpy[n]["items_per_second"])))
 lines += ["", "Items: see each benchmark's comment (demodulator: f,g sample pairs).", ""]
 
-# The issues' targets against this run.
-by_name = {b["name"]: b for b in cpp.get("benchmarks", []) if b.get("run_type") != "aggregate"}
+# The issues' targets against this run (medians).
 
 def seconds(b):
     scale = {"ns": 1e-9, "us": 1e-6, "ms": 1e-3, "s": 1.0}[b.get("time_unit", "ns")]
