@@ -10,6 +10,7 @@ namespace cvg_bench {
 namespace {
 
 using simd::load4;
+using simd::store4;
 using simd::V4;
 
 constexpr int kBatchBlocks = 64;
@@ -34,8 +35,7 @@ void accumulateTiles(const double* batch, int blocks, int kpad, double* partial)
       const int rows[4] = {it, it + 1, it, it + 1}, cols[4] = {jt, jt, jt + 1, jt + 1};
       for (int t = 0; t < 4; ++t) {
         double* p = partial + (static_cast<long>(rows[t]) * kpad + cols[t]) * 4;
-        const V4 v = load4(p) + *sums[t];
-        std::memcpy(p, &v, sizeof(v));
+        store4(p, load4(p) + *sums[t]);
       }
     }
   }

@@ -10,11 +10,8 @@ namespace cvg_bench {
 namespace {
 
 using simd::load4;
+using simd::store4;
 using simd::V4;
-
-__attribute__((always_inline)) inline void store4(double* p, const V4& v) {
-  std::memcpy(p, &v, sizeof(v));
-}
 
 /// Block i's D-bar_i (columns of 4) into the terms of samples i-1 (u -= 2 D, v += w0 D),
 /// i (v += w1 D) and i+1 (u = 2 D, v = w2 D: its first block).

@@ -10,13 +10,11 @@ namespace cvg_bench {
 namespace {
 
 using simd::load4;
+using simd::store4;
 using simd::V4;
 
 constexpr int kPanel = 4;
 
-__attribute__((always_inline)) inline void store4(double* p, const V4& v) {
-  std::memcpy(p, &v, sizeof(v));
-}
 __attribute__((always_inline)) inline double sum4(const V4& v) {
   return (v[0] + v[1]) + (v[2] + v[3]);
 }

@@ -8,14 +8,14 @@ namespace cvg_bench {
 namespace {
 
 using simd::load4;
+using simd::store4;
 using simd::V4;
 
 CVG_HOT_CLONES
 void weightedSum3(double w0, const double* a, double w1, const double* b, double w2,
                   const double* c, int n, double* out) {
   for (int i = 0; i < n; i += 4) {
-    const V4 v = w0 * load4(a + i) + w1 * load4(b + i) + w2 * load4(c + i);
-    std::memcpy(out + i, &v, sizeof(v));
+    store4(out + i, w0 * load4(a + i) + w1 * load4(b + i) + w2 * load4(c + i));
   }
 }
 
@@ -28,8 +28,7 @@ void residual(const double* d, const double* z, int k, const double* y, double* 
     acc1 -= z[c + 1] * load4(d + 4 * (c + 1));
   }
   if (c < k) acc0 -= z[c] * load4(d + 4 * c);
-  const V4 v = acc0 + acc1;
-  std::memcpy(r, &v, sizeof(v));
+  store4(r, acc0 + acc1);
 }
 
 }  // namespace

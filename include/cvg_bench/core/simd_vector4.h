@@ -1,6 +1,7 @@
 // Four doubles as one GCC vector (the hot loops of the demodulator chain: the 4-channel filter and
-// the batch validator), with an unaligned load, and CVG_HOT_CLONES to compile a function also for
-// x86-64-v3 (AVX2/FMA) with dispatch at load time. Portable: the default clone is plain x86-64.
+// the batch validator; the batch least-squares kernels), with unaligned load and store, and
+// CVG_HOT_CLONES to compile a function also for x86-64-v3 (AVX2/FMA) with dispatch at load time.
+// Portable: the default clone is plain x86-64.
 #pragma once
 
 #include <cstring>
@@ -17,6 +18,10 @@ inline V4 load4(const double* p) {
   V4 v;
   std::memcpy(&v, p, sizeof(v));
   return v;
+}
+
+inline void store4(double* p, const V4& v) {
+  std::memcpy(p, &v, sizeof(v));
 }
 
 }  // namespace simd
