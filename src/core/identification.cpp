@@ -59,6 +59,13 @@ struct SquaredExcitation {
   }
 };
 
+template <class Record>
+std::vector<const Record*> pointersTo(const std::vector<Record>& records) {
+  std::vector<const Record*> p;
+  for (const auto& r : records) p.push_back(&r);
+  return p;
+}
+
 std::string fmt(double v) {
   std::ostringstream s;
   s.precision(6);
@@ -369,9 +376,7 @@ Estimate identifyFreeDecay(const SlowRecord& record, const IdentificationOptions
 
 Estimate identifyFreeDecay(const std::vector<SlowRecord>& records,
                            const IdentificationOptions& options) {
-  std::vector<const SlowRecord*> pointers;
-  for (const auto& r : records) pointers.push_back(&r);
-  return identifyFreeDecayRecords(pointers, options);
+  return identifyFreeDecayRecords(pointersTo(records), options);
 }
 
 namespace {
@@ -424,9 +429,7 @@ Estimate identifyForced(const SweepRecord& record, const IdentificationOptions& 
 
 Estimate identifyForced(const std::vector<SweepRecord>& records,
                         const IdentificationOptions& options) {
-  std::vector<const SweepRecord*> pointers;
-  for (const auto& r : records) pointers.push_back(&r);
-  return identifyForcedRecords(pointers, options);
+  return identifyForcedRecords(pointersTo(records), options);
 }
 
 StackedSystem buildFreeDecaySystem(const std::vector<SlowRecord>& records,
