@@ -14,6 +14,7 @@
 #include "cvg_bench/core/errors.h"
 #include "cvg_bench/core/explanation.h"
 #include "cvg_bench/core/orbit_elements.h"
+#include "cvg_bench/report/explain_json.h"
 #include "cvg_bench/ros/conversions.h"
 
 namespace cvg_bench {
@@ -406,9 +407,7 @@ bool IdentifierNode::onExplain(Explain::Request& req, Explain::Response& res) {
     res.success = true;
     res.message = ex.cause + " [selected: " + (selected.empty() ? "none" : selected) +
                   (ex.unexplained ? "; structure remains unexplained" : "") + "]";
-    // The JSON of `cvg_ident explain` is written by the tool (src/tools/explain_json.cpp); until it
-    // is shared with the nodes, report_json stays empty.
-    res.report_json = "";
+    res.report_json = report::explanationToJson(ex).dump();  // as `cvg_ident explain` writes
   } catch (const std::exception& e) {
     res.success = false;
     res.message = e.what();

@@ -10,11 +10,15 @@
 #include "cvg_bench/core/derived_uncertainty.h"
 #include "cvg_bench/core/errors.h"
 #include "cvg_bench/core/orbit_elements.h"
+#include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
-#include "estimate_json.h"
 
 namespace cvg_bench {
 namespace tools {
+
+using report::ParameterFile;
+using report::readParameterFile;
+using report::writeJsonFile;
 namespace {
 
 const char* kHelp =

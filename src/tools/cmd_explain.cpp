@@ -13,13 +13,16 @@
 #include "cvg_bench/core/frequency_estimator.h"
 #include "cvg_bench/core/irregular_demodulator.h"
 #include "cvg_bench/core/record_io.h"
+#include "cvg_bench/report/estimate_json.h"
+#include "cvg_bench/report/explain_json.h"
 #include "cvg_ident_commands.h"
-#include "estimate_json.h"
-#include "explain_json.h"
 #include "explain_report_files.h"
 
 namespace cvg_bench {
 namespace tools {
+
+using report::explanationToJson;
+using report::writeJsonFile;
 namespace {
 
 const char* kHelp =

@@ -15,11 +15,14 @@
 #include "cvg_bench/core/identification.h"
 #include "cvg_bench/core/irregular_demodulator.h"
 #include "cvg_bench/core/record_io.h"
+#include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
-#include "estimate_json.h"
 
 namespace cvg_bench {
 namespace tools {
+
+using report::estimateToJson;
+using report::writeJsonFile;
 namespace {
 
 const char* kHelp =

@@ -12,10 +12,12 @@
 #include "cvg_bench/core/orbit_elements.h"
 #include "cvg_bench/core/output_error_free_decay.h"
 #include "cvg_bench/core/stationary_solver.h"
-#include "estimate_json.h"
+#include "cvg_bench/report/estimate_json.h"
 
 namespace cvg_bench {
 namespace tools {
+
+using report::writeJsonFile;
 namespace {
 
 void makeDirectory(const std::string& dir) {

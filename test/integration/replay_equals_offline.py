@@ -107,6 +107,19 @@ class ReplayEqualsOffline(unittest.TestCase):
         explained = rospy.ServiceProxy("/cvg/explain", Explain)(mode="")
         self.assertTrue(explained.success, explained.message)
         self.assertIn("xi", explained.message)  # the simulated ring has cubic stiffness
+        report = json.loads(explained.report_json)  # the JSON of `cvg_ident explain`
+        for key in ("baseline", "steps", "selected", "unexplained", "cause", "final"):
+            self.assertIn(key, report)
+        self.assertIn("xi", report["selected"])
+        tools = roslib.packages.find_node("cvg_bench", "cvg_ident")
+        out = os.path.join(tempfile.mkdtemp(prefix="cvg_replay_"), "explain.json")
+        proc = subprocess.run([tools[0], "explain", rospy.get_param("~bag"), "--mode", "free_decay",
+                               "--json", out], capture_output=True, text=True)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        with open(out) as f:
+            offline = json.load(f)
+        self.assertEqual(report["selected"], offline["selected"])  # same window, same answer
+        self.assertEqual(report["final"]["model"], offline["final"]["model"])
 
         reset = rospy.ServiceProxy("/cvg/identifier/reset", Reset)()
         self.assertTrue(reset.success)

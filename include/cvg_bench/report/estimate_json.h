@@ -8,7 +8,7 @@
 #include "cvg_bench/core/resonator_model.h"
 
 namespace cvg_bench {
-namespace tools {
+namespace report {
 
 /// The identify JSON of interfaces.md (plus "dof", "method", "covariance", "notes").
 nlohmann::json estimateToJson(const Estimate& e);
@@ -29,5 +29,5 @@ ParameterFile readParameterFile(const std::string& path);
 /// Writes JSON to path ("-" = stdout), pretty-printed; throws InputError if it cannot be written.
 void writeJsonFile(const nlohmann::json& j, const std::string& path);
 
-}  // namespace tools
+}  // namespace report
 }  // namespace cvg_bench

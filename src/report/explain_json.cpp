@@ -1,11 +1,11 @@
-#include "explain_json.h"
+#include "cvg_bench/report/explain_json.h"
 
 #include <cmath>
 
-#include "estimate_json.h"
+#include "cvg_bench/report/estimate_json.h"
 
 namespace cvg_bench {
-namespace tools {
+namespace report {
 namespace {
 
 /// JSON has no infinity: a hold-out ratio of a model whose prediction diverged is written as null.
@@ -67,5 +67,5 @@ nlohmann::json explanationToJson(const Explanation& x) {
   return j;
 }
 
-}  // namespace tools
+}  // namespace report
 }  // namespace cvg_bench

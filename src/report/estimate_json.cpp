@@ -1,4 +1,4 @@
-#include "estimate_json.h"
+#include "cvg_bench/report/estimate_json.h"
 
 #include <cmath>
 #include <fstream>
@@ -7,7 +7,7 @@
 #include "cvg_bench/core/errors.h"
 
 namespace cvg_bench {
-namespace tools {
+namespace report {
 namespace {
 
 nlohmann::json parameterToJson(const ParameterEstimate& p) {
@@ -137,5 +137,5 @@ void writeJsonFile(const nlohmann::json& j, const std::string& path) {
   out << j.dump(2) << "\n";
 }
 
-}  // namespace tools
+}  // namespace report
 }  // namespace cvg_bench

@@ -9,9 +9,9 @@
 #include "cvg_bench/core/explanation.h"
 
 namespace cvg_bench {
-namespace tools {
+namespace report {
 
 nlohmann::json explanationToJson(const Explanation& x);
 
-}  // namespace tools
+}  // namespace report
 }  // namespace cvg_bench
