@@ -11,10 +11,14 @@ CATKIN_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release -
 deps:
 	@bash scripts/install_deps.sh
 
+# The package is linked into the workspace under a hidden source folder (.src): roslib's resource
+# search walks the package (following links) and skips only hidden folders, so a visible link back
+# to the repository from inside build/ would loop (`roslaunch cvg_bench X.launch` failed).
 build: deps
-	@mkdir -p $(WS)/src
-	@ln -sfn ../../.. $(WS)/src/cvg_bench
-	@cd $(WS) && catkin_make $(CATKIN_ARGS) -j$(JOBS) > ../catkin_build.log 2>&1 \
+	@if [ -e $(WS)/src ]; then echo "make build: moving to the .src layout (full rebuild)"; rm -rf $(WS); fi
+	@mkdir -p $(WS)/.src
+	@ln -sfn ../../.. $(WS)/.src/cvg_bench
+	@cd $(WS) && catkin_make --source .src $(CATKIN_ARGS) -j$(JOBS) > ../catkin_build.log 2>&1 \
 	  || { tail -n 60 ../catkin_build.log; echo "make build: failed (full log: build/catkin_build.log)"; exit 1; }
 	@echo "make build: ok (tool: bin/cvg_ident)"
 

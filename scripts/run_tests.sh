@@ -16,7 +16,7 @@ set -u
 export ROS_HOME="$root/build/ros_home"
 export ROS_LOG_DIR="$ROS_HOME/log"
 
-(cd "$ws" && catkin_make run_tests -DPYTHON_EXECUTABLE=/usr/bin/python3 -j2 > "$root/build/run_tests.log" 2>&1)
+(cd "$ws" && catkin_make --source .src run_tests -DPYTHON_EXECUTABLE=/usr/bin/python3 -j2 > "$root/build/run_tests.log" 2>&1)
 grep -E "^\[ *(FAILED|  PASSED) *\]|FAILURE|^\[ROSTEST\]|Ran [0-9]+ test" "$root/build/run_tests.log" | tail -n 40
 
 if ls test/python/test_*.py >/dev/null 2>&1; then
