@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/demodulator_noise.h"
 #include "cvg_bench/core/errors.h"
 #include "cvg_bench/core/simd_vector4.h"
 
@@ -351,6 +352,10 @@ SlowRecord demodulateUniform(const RawRecord& raw, DemodulatorOptions options,
     << options.attenuation_db << " dB, stages";
   for (const FilterStage& s : demod.stages()) d << " " << s.n_taps << " taps/" << s.decimation;
   rec.metadata["demodulation"] = d.str();
+  std::ostringstream rho;
+  rho.precision(6);
+  for (double r : outputNoiseCorrelation(demod.stages())) rho << (rho.tellp() > 0 ? " " : "") << r;
+  if (rho.tellp() > 0) rec.metadata[kNoiseCorrelationKey] = rho.str();
   std::vector<double> segment;
   for (const SlowSample& s : slow) {
     rec.t_s.push_back(s.t_s);

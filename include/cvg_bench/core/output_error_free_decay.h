@@ -5,9 +5,9 @@
 // variables q(t_0):
 //   r_i = q_model(t_i; z, q(t_0)) - q_measured(t_i),  i = 0..N  (4 (N + 1) residuals, units of q).
 // Unlike the equation error of (2.7)-(2.8), the noisy measurement never enters the model, so the
-// residuals are the measurement noise itself, which makes Ceres' covariance honest when that noise
-// is white (NOTES.md items 10, 15); demodulated slow samples carry filtered noise and the intervals
-// come out ~15 % narrow there (docs/validation.md, "Through the demodulator"). Derivatives: ceres::DynamicNumericDiffCostFunction, central differences
+// residuals are the measurement noise itself, which makes Ceres' covariance honest (NOTES.md items
+// 10, 15); noise filtered by the demodulator is correlated between samples, and a record that says
+// how (demodulator_noise.h) gets the covariance with that correlation (docs/validation.md). Derivatives: ceres::DynamicNumericDiffCostFunction, central differences
 // while iterating, Ridders' extrapolation for the final Jacobian (covariance, rank).
 #pragma once
 
