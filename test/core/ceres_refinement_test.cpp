@@ -16,6 +16,7 @@
 #include "cvg_bench/core/errors.h"
 #include "cvg_bench/core/identification.h"
 #include "cvg_bench/core/output_error_free_decay.h"
+#include "identification_test_support.h"
 
 namespace cvg_bench {
 namespace {
@@ -167,11 +168,7 @@ TEST(CeresRefinement, StatedNoiseCorrelationKeepsTheIntervalsHonest) {
     const Estimate e =
         refineWithCeres(record, startEstimate("xi", ExperimentMode::kFreeDecay, kFreeTruth, 0.05));
     EXPECT_NE(e.interval_method.find("noise correlation"), std::string::npos) << e.interval_method;
-    for (const auto& kv : kFreeTruth) {
-      const ParameterEstimate& p = e.parameters.at(kv.first);
-      covered += p.ci_low <= kv.second && kv.second <= p.ci_high;
-      ++total;
-    }
+    testing_support::countCoverage(e, kFreeTruth, &covered, &total);
   }
   const double coverage = static_cast<double>(covered) / total;
   EXPECT_GE(coverage, 0.9);

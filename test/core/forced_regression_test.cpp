@@ -45,11 +45,7 @@ TEST(ForcedIdentification, NoisySweepIsCoveredByTheIntervals) {
   int covered = 0, total = 0;
   for (unsigned seed = 1; seed <= 20; ++seed) {
     const Estimate e = identifyForced(testing_support::withNoise(clean, 3e-4, seed), cubic());
-    for (const auto& kv : kSection4) {
-      const ParameterEstimate& p = e.parameters.at(kv.first);
-      covered += p.ci_low <= kv.second && kv.second <= p.ci_high;
-      ++total;
-    }
+    testing_support::countCoverage(e, kSection4, &covered, &total);
   }
   const double coverage = static_cast<double>(covered) / total;
   EXPECT_GE(coverage, 0.85);

@@ -7,11 +7,23 @@
 #include <random>
 #include <vector>
 
+#include "cvg_bench/core/estimate.h"
 #include "cvg_bench/core/records.h"
 #include "cvg_bench/core/resonator_model.h"
 
 namespace cvg_bench {
 namespace testing_support {
+
+/// Counts the parameters of `truth` whose reported interval contains the true value (covered) and
+/// all of them (total).
+inline void countCoverage(const Estimate& e, const ParameterValues& truth, int* covered,
+                          int* total) {
+  for (const auto& kv : truth) {
+    const ParameterEstimate& p = e.parameters.at(kv.first);
+    *covered += p.ci_low <= kv.second && kv.second <= p.ci_high;
+    ++*total;
+  }
+}
 
 /// n_samples samples of the averaged free decay at dt spacing, RK4 with `substeps` steps each.
 inline SlowRecord simulateFreeDecay(const ResonatorModel& model, const Eigen::VectorXd& z,
