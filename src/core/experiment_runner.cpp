@@ -157,11 +157,15 @@ Eigen::Vector4d ExperimentRunner::freeDecayInitialState() const {
 }
 
 SlowRecord ExperimentRunner::freeDecaySlow(double duration_s) const {
+  return freeDecaySlow(duration_s, freeDecayInitialState());
+}
+
+SlowRecord ExperimentRunner::freeDecaySlow(double duration_s, const Eigen::Vector4d& q0) const {
   requirePositive(duration_s, "free decay duration");
   const ResonatorModel model(preset_.truthModelSpec(ExperimentMode::kFreeDecay),
                              ExperimentMode::kFreeDecay);
   SlowSimulator sim(model, preset_.truthParameters(model));
-  sim.reset(freeDecayInitialState(), 0.0);
+  sim.reset(q0, 0.0);
   SlowRecord rec;
   rec.omega_rad_s = preset_.omega_rad_s;
   const size_t n = static_cast<size_t>(std::floor(duration_s * preset_.decay_sample_rate_hz)) + 1;
@@ -170,6 +174,10 @@ SlowRecord ExperimentRunner::freeDecaySlow(double duration_s) const {
 }
 
 RawRecord ExperimentRunner::freeDecayRaw(double duration_s) const {
+  return freeDecayRaw(duration_s, freeDecayInitialState());
+}
+
+RawRecord ExperimentRunner::freeDecayRaw(double duration_s, const Eigen::Vector4d& q0) const {
   requirePositive(duration_s, "free decay duration");
   const ResonatorModel model(preset_.truthModelSpec(ExperimentMode::kFreeDecay),
                              ExperimentMode::kFreeDecay);
@@ -177,7 +185,7 @@ RawRecord ExperimentRunner::freeDecayRaw(double duration_s) const {
   fo.steps_per_period = preset_.steps_per_period;
   FastSimulator sim(model, preset_.truthParameters(model), preset_.omega_rad_s, preset_.omega_rad_s,
                     0.0, {}, fo);
-  sim.reset(freeDecayInitialState(), 0.0);
+  sim.reset(q0, 0.0);
   RawRecord rec;
   rec.omega_rad_s = preset_.omega_rad_s;
   rec.metadata["mode"] = "free_decay";
@@ -295,11 +303,25 @@ AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOpti
   md["seed"] = std::to_string(options.seed);
 
   if (mode == ExperimentMode::kFreeDecay) {
-    md["drive_detuning_rad_s"] = num(preset.decay_drive_detuning_rad_s);
+    const OrbitElements& start = options.free_decay_start;
+    Eigen::Vector4d q0;
+    if (start.r == 0.0) {
+      md["drive_detuning_rad_s"] = num(preset.decay_drive_detuning_rad_s);
+      q0 = runner.freeDecayInitialState();
+    } else {
+      if (!(std::isfinite(start.r) && start.r > 0.0 && std::isfinite(start.k) &&
+            std::abs(start.k) <= start.r && std::isfinite(start.theta) && std::isfinite(start.chi)))
+        throw InputError("free-decay start: need r > 0, |k| <= r, finite theta and chi, got r = " +
+                         num(start.r) + ", k = " + num(start.k) + ", theta = " + num(start.theta) +
+                         ", chi = " + num(start.chi));
+      md["free_decay_start"] = "r " + num(start.r) + ", k " + num(start.k) + ", theta_rad " +
+                               num(start.theta) + ", chi_rad " + num(start.chi);
+      q0 = slowFromOrbit(start);
+    }
     if (options.raw) {
       const double d = options.duration_s > 0 ? options.duration_s : preset.decay_raw_duration_s;
       out.kind = RecordKind::kRaw;
-      out.raw = runner.freeDecayRaw(d);
+      out.raw = runner.freeDecayRaw(d, q0);
       noise.addTo(out.raw, fg_std);
       md["noise_std"] = num(fg_std);
       md["integrator"] = "full equations (2.3), RK4 in osculating variables, " +
@@ -308,7 +330,7 @@ AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOpti
     } else {
       const double d = options.duration_s > 0 ? options.duration_s : preset.decay_duration_s;
       out.kind = RecordKind::kFreeDecay;
-      out.slow = runner.freeDecaySlow(d);
+      out.slow = runner.freeDecaySlow(d, q0);
       noise.addTo(out.slow, q_std);
       md["noise_std"] = num(q_std);
       md["integrator"] = "averaged model (2.6), Dormand-Prince 5(4)";

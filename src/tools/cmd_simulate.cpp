@@ -1,5 +1,6 @@
 // cvg_ident simulate: a simulated record from a resonator preset (interfaces.md).
 #include <iostream>
+#include <sstream>
 
 #include "cli_args.h"
 #include "cvg_bench/core/errors.h"
@@ -15,7 +16,7 @@ namespace {
 const char* kHelp =
     "usage: cvg_ident simulate --preset NAME|--config FILE --mode free_decay|forced [--raw]\n"
     "                          [--seed N] [--effect NAME=VALUE ...] [--noise STD]\n"
-    "                          [--duration S] --out FILE\n"
+    "                          [--duration S] [--start R,K,THETA] --out FILE\n"
     "Simulates a record of a resonator preset and writes it as CSV with `# omega:`, `# mode:` and\n"
     "the true parameters as `# truth_<name>: value` lines.\n"
     "  --preset NAME     shipped preset (config/resonators/NAME.yaml): mems_ring,\n"
@@ -35,12 +36,16 @@ const char* kHelp =
     "                    forced only; 0 = off)\n"
     "  --noise STD       noise std overriding the preset's (q, or f, g with --raw); 0 = none\n"
     "  --duration S      record length [s] overriding the preset's (forced --raw: per step)\n"
+    "  --start R,K,THETA free decay only: start from the orbit elements (5.2) amplitude R > 0,\n"
+    "                    quadrature K (|K| <= R) and pattern angle THETA [rad] instead of the\n"
+    "                    drive's stationary state (e.g. to probe the axes at several angles)\n"
     "  --out FILE        output CSV\n";
 
 }  // namespace
 
 int runSimulate(const std::vector<std::string>& argv) {
-  const CliArgs args(argv, {"preset", "config", "mode", "seed", "out", "noise", "duration"},
+  const CliArgs args(argv,
+                     {"preset", "config", "mode", "seed", "out", "noise", "duration", "start"},
                      {"raw"}, {"effect"});
   if (args.help()) {
     std::cout << kHelp;
@@ -65,6 +70,27 @@ int runSimulate(const std::vector<std::string>& argv) {
   if (args.has("noise") && options.noise_std < 0) throw InputError("--noise must be >= 0");
   options.duration_s = args.getDouble("duration", 0.0);
   if (args.has("duration") && options.duration_s <= 0) throw InputError("--duration must be > 0");
+  if (args.has("start")) {
+    if (options.mode != ExperimentMode::kFreeDecay)
+      throw InputError("--start applies to --mode free_decay only");
+    std::istringstream in(args.get("start"));
+    std::string item;
+    std::vector<double> v;
+    while (std::getline(in, item, ',')) {
+      try {
+        size_t used = 0;
+        v.push_back(std::stod(item, &used));
+        if (used != item.size()) throw std::invalid_argument(item);
+      } catch (const std::exception&) {
+        throw InputError("--start: '" + item + "' is not a number (give R,K,THETA)");
+      }
+    }
+    if (v.size() != 3) throw InputError("--start needs R,K,THETA (three numbers)");
+    options.free_decay_start.r = v[0];
+    options.free_decay_start.k = v[1];
+    options.free_decay_start.theta = v[2];
+    if (!(v[0] > 0.0)) throw InputError("--start: R must be > 0");
+  }
 
   const AnyRecord rec = simulateExperiment(preset, options);
   const std::string out = args.get("out");

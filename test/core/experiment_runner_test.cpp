@@ -35,6 +35,37 @@ TEST(ExperimentRunner, FreeDecayStartsFromTheStationaryForcedOscillation) {
   EXPECT_NEAR(decay, p.parameters.at("gamma") / 2, 0.1 * p.parameters.at("gamma") / 2);
 }
 
+// A free decay started from chosen orbit elements: the first slow sample has them (the averaged
+// model), the full equations start at the same osculating state (f(0) = q1, g(0) = q2 at t = 0),
+// and the elements are written to the metadata; impossible elements are refused.
+TEST(ExperimentRunner, FreeDecayCanStartFromChosenOrbitElements) {
+  const ResonatorPreset p = memsRing();
+  SimulationOptions o;
+  o.mode = ExperimentMode::kFreeDecay;
+  o.noise_std = 0.0;
+  o.free_decay_start.r = 0.5;
+  o.free_decay_start.k = 0.1;
+  o.free_decay_start.theta = 0.3;
+  const SlowRecord slow = simulateExperiment(p, o).slow;
+  const OrbitElements e = orbitFromSlow(slow.q.front());
+  EXPECT_NEAR(e.r, 0.5, 1e-12);
+  EXPECT_NEAR(e.k, 0.1, 1e-12);
+  EXPECT_NEAR(e.theta, 0.3, 1e-12);
+  EXPECT_EQ(slow.metadata.count("free_decay_start"), 1u);
+  EXPECT_EQ(slow.metadata.count("drive_detuning_rad_s"), 0u);
+  o.raw = true;
+  o.duration_s = 0.01;
+  const RawRecord raw = simulateExperiment(p, o).raw;
+  const Eigen::Vector4d q0 = slowFromOrbit(o.free_decay_start);
+  EXPECT_NEAR(raw.f.front(), q0[0], 1e-12);
+  EXPECT_NEAR(raw.g.front(), q0[2], 1e-12);
+  o.free_decay_start.k = 0.6;  // |k| > r: no such orbit
+  EXPECT_THROW(simulateExperiment(p, o), InputError);
+  o.free_decay_start.k = 0.1;
+  o.free_decay_start.theta = std::nan("");
+  EXPECT_THROW(simulateExperiment(p, o), InputError);
+}
+
 TEST(ExperimentRunner, PaperRingSweepIsStationaryWithoutJumps) {
   const ResonatorPreset p = memsRing();
   const SweepResult sweep = ExperimentRunner(p).forcedSweep();

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "cvg_bench/core/orbit_elements.h"
 #include "cvg_bench/core/record_io.h"
 #include "cvg_bench/core/records.h"
 #include "cvg_bench/core/resonator_preset.h"
@@ -62,10 +63,14 @@ class ExperimentRunner {
   /// Initial osculating state of the free decay at t = 0, van der Pol variables at W = omega.
   Eigen::Vector4d freeDecayInitialState() const;
 
-  /// Free decay, slow variables by the averaged model, sampled at the preset's rate (noise-free).
+  /// Free decay, slow variables by the averaged model, sampled at the preset's rate (noise-free),
+  /// from freeDecayInitialState() or from q0 (van der Pol variables at W = omega).
   SlowRecord freeDecaySlow(double duration_s) const;
-  /// Free decay, raw f, g by the full equations at the preset's raw rate (noise-free).
+  SlowRecord freeDecaySlow(double duration_s, const Eigen::Vector4d& q0) const;
+  /// Free decay, raw f, g by the full equations at the preset's raw rate (noise-free), from
+  /// freeDecayInitialState() or from q0.
   RawRecord freeDecayRaw(double duration_s) const;
+  RawRecord freeDecayRaw(double duration_s, const Eigen::Vector4d& q0) const;
   /// Forced sweep (noise-free stationary states).
   SweepResult forcedSweep() const;
   /// Raw f, g of each settled sweep step by the full equations at W = omega0: segments of
@@ -90,6 +95,10 @@ struct SimulationOptions {
   /// Record length overriding the preset's [s] (free decay: the record; forced raw: each
   /// segment); <= 0 = the preset's.
   double duration_s = 0.0;
+  /// Free decay only: start from these orbit elements (5.2) at t = 0 instead of the stationary
+  /// state of the preset's drive: r > 0 the wave amplitude [amplitude units], |k| <= r the
+  /// quadrature, theta the pattern angle [rad], chi the temporal phase [rad]. r = 0 = the drive.
+  OrbitElements free_decay_start;
 };
 
 /// Runs the experiment, adds the noise and fills the metadata (omega, mode, preset, truth_model,
