@@ -66,7 +66,16 @@ SimulatorNode::SimulatorNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
 
 bool SimulatorNode::onStartFreeDecay(StartFreeDecay::Request& req, StartFreeDecay::Response& res) {
   try {
-    startFreeDecay(req.duration_s, req.seed > 0 ? static_cast<int>(req.seed) : options_.seed);
+    OrbitElements start;
+    if (req.amplitude != 0.0) {
+      start.r = req.amplitude;
+      start.k = req.quadrature;
+      start.theta = req.theta_rad;
+    } else if (req.quadrature != 0.0 || req.theta_rad != 0.0) {
+      throw InputError("quadrature/theta_rad given without amplitude (amplitude 0 = the drive)");
+    }
+    startFreeDecay(req.duration_s, req.seed > 0 ? static_cast<int>(req.seed) : options_.seed,
+                   start);
     res.success = true;
     res.message = "free decay started: " + std::to_string(raw_.size()) + " raw samples, " +
                   std::to_string(slow_.size()) + " slow states";
@@ -98,7 +107,7 @@ bool SimulatorNode::onStartSweep(StartSweep::Request& req, StartSweep::Response&
   return true;
 }
 
-void SimulatorNode::startFreeDecay(double duration_s, int seed) {
+void SimulatorNode::startFreeDecay(double duration_s, int seed, const OrbitElements& start) {
   requireFinite(duration_s, "duration_s");
   if (duration_s < 0.0) throw InputError("duration_s must be >= 0");
   running_ = Running::kNone;
@@ -106,6 +115,7 @@ void SimulatorNode::startFreeDecay(double duration_s, int seed) {
   SimulationOptions sim;
   sim.mode = ExperimentMode::kFreeDecay;
   sim.seed = static_cast<std::uint64_t>(seed);
+  sim.free_decay_start = start;
   raw_ = RawRecord();
   slow_ = SlowRecord();
   slow_truth_ = SlowRecord();

@@ -128,6 +128,25 @@ class DemodMatchesTruth(unittest.TestCase):
         self.assertEqual(int(self.diagnostics["rejected_total"]), 0)
         self.assertEqual(int(self.diagnostics["accepted"]), n_raw)
 
+        # A free decay from chosen orbit elements (5.2): the first noise-free slow state has
+        # |q|^2 = r^2 + k^2; impossible requests are refused with a reason.
+        start = rospy.ServiceProxy("/cvg/start_free_decay", StartFreeDecay)
+        bad = start(duration_s=0.0, seed=3, amplitude=0.0, quadrature=0.1, theta_rad=0.0)
+        self.assertFalse(bad.success)
+        self.assertIn("amplitude", bad.message)
+        bad = start(duration_s=0.0, seed=3, amplitude=0.5, quadrature=0.6, theta_rad=0.3)
+        self.assertFalse(bad.success)
+        self.assertIn("|k| <= r", bad.message)
+        with self.lock:
+            self.exact = []
+        res = start(duration_s=0.0, seed=3, amplitude=0.5, quadrature=0.1, theta_rad=0.3)
+        self.assertTrue(res.success, res.message)
+        self.wait_until(lambda: len(self.exact) >= 1, timeout, "the first slow state of the new run")
+        with self.lock:
+            first = self.exact[0]
+        norm_sq = first.q1 ** 2 + first.p1 ** 2 + first.q2 ** 2 + first.p2 ** 2
+        self.assertAlmostEqual(norm_sq, 0.5 ** 2 + 0.1 ** 2, delta=1e-9)
+
 
 if __name__ == "__main__":
     rospy.init_node("demod_matches_truth_test")

@@ -13,6 +13,7 @@
 
 #include "cvg_bench/StartFreeDecay.h"
 #include "cvg_bench/StartSweep.h"
+#include "cvg_bench/core/orbit_elements.h"
 #include "cvg_bench/core/records.h"
 #include "cvg_bench/core/resonator_preset.h"
 #include "cvg_bench/ros/simulator_node_options.h"
@@ -30,7 +31,8 @@ class SimulatorNode {
   bool onStartFreeDecay(StartFreeDecay::Request& req, StartFreeDecay::Response& res);
   bool onStartSweep(StartSweep::Request& req, StartSweep::Response& res);
   /// Simulates the whole record now (InputError / AnalysisError from the core pass through).
-  void startFreeDecay(double duration_s, int seed);
+  /// start.r = 0: from the drive's stationary state; else from these orbit elements.
+  void startFreeDecay(double duration_s, int seed, const OrbitElements& start = OrbitElements());
   void startSweep(const ResonatorPreset& preset, int seed);
   void beginStreaming(Running what, ExperimentMode mode, const ResonatorPreset& preset);
   void onTick(const ros::WallTimerEvent&);
