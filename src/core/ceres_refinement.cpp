@@ -198,8 +198,8 @@ void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estima
     }
     const double effective_dof = n - (unscaled_cov * s_mat).trace();
     if (effective_dof > 0.0) {
-      const double sigma2_white = 2.0 * cost / effective_dof;
-      full_cov = sigma2_white * unscaled_cov * s_mat * unscaled_cov;
+      const double sigma2_sample = 2.0 * cost / effective_dof;  // noise variance of one sample
+      full_cov = sigma2_sample * unscaled_cov * s_mat * unscaled_cov;
       full_cov = 0.5 * (full_cov + full_cov.transpose());
       std::ostringstream m;
       m.precision(3);
@@ -208,6 +208,10 @@ void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estima
         << fp.noise_correlation[0] << ", " << fp.noise_correlation.size()
         << " lags; the white-noise formula is ~15 % too narrow on demodulated samples), Student-t";
       interval_method = m.str();
+    } else {
+      e->notes.push_back(
+          "the record's noise correlation leaves no degrees of freedom (n - tr(C J' Sigma J) <= "
+          "0): white-noise covariance reported, too narrow for filtered samples");
     }
   }
 

@@ -285,6 +285,19 @@ RawRecord ExperimentRunner::forcedSweepRaw(const SweepResult& sweep, double segm
   return rec;
 }
 
+SweepRecord sweepRecordOf(const SweepResult& sweep, double omega_rad_s) {
+  SweepRecord rec;
+  rec.omega_rad_s = omega_rad_s;
+  for (const auto& s : sweep.steps) {
+    rec.omega0_rad_s.push_back(s.omega0_rad_s);
+    rec.q.push_back(s.q);
+    rec.direction.push_back(s.direction);
+    rec.jump.push_back(s.jump ? 1 : 0);
+    rec.extra["stationary"].push_back(s.settled ? 1.0 : 0.0);
+  }
+  return rec;
+}
+
 AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOptions& options) {
   const ExperimentRunner runner(preset);
   if (options.noise_std >= 0.0 && !std::isfinite(options.noise_std))
@@ -368,15 +381,8 @@ AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOpti
     return out;
   }
   out.kind = RecordKind::kForcedSweep;
+  out.sweep = sweepRecordOf(sweep, preset.omega_rad_s);
   SweepRecord& rec = out.sweep;
-  rec.omega_rad_s = preset.omega_rad_s;
-  for (const auto& s : sweep.steps) {
-    rec.omega0_rad_s.push_back(s.omega0_rad_s);
-    rec.q.push_back(s.q);
-    rec.direction.push_back(s.direction);
-    rec.jump.push_back(s.jump ? 1 : 0);
-    rec.extra["stationary"].push_back(s.settled ? 1.0 : 0.0);
-  }
   noise.addTo(rec, q_std);
   md["noise_std"] = num(q_std);
   md["integrator"] = "averaged model (3.3) settled per step, Newton-polished";

@@ -146,16 +146,9 @@ void SimulatorNode::startSweep(const ResonatorPreset& preset, int seed) {
   raw_ = RawRecord();
   slow_ = SlowRecord();
   slow_truth_ = SlowRecord();
-  sweep_ = SweepRecord();
+  sweep_ = sweepRecordOf(result, preset.omega_rad_s);
   settled_.clear();
-  sweep_.omega_rad_s = preset.omega_rad_s;
-  for (const SweepStep& s : result.steps) {
-    sweep_.omega0_rad_s.push_back(s.omega0_rad_s);
-    sweep_.q.push_back(s.q);
-    sweep_.direction.push_back(s.direction);
-    sweep_.jump.push_back(s.jump ? 1 : 0);
-    settled_.push_back(s.settled);
-  }
+  for (const SweepStep& s : result.steps) settled_.push_back(s.settled);
   MeasurementNoise noise(static_cast<std::uint64_t>(seed));
   noise.addTo(sweep_, preset.noise_q_std);
   beginStreaming(Running::kSweep, ExperimentMode::kForced, preset);

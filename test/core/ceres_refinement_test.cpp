@@ -17,19 +17,15 @@
 #include "cvg_bench/core/identification.h"
 #include "cvg_bench/core/output_error_free_decay.h"
 #include "identification_test_support.h"
+#include "paper_section4_estimate.h"
 
 namespace cvg_bench {
 namespace {
 
-const ParameterValues kFreeTruth = {{"gamma", 0.5}, {"nu", 0.3},   {"b_c", 0.1},
-                                    {"b_s", -0.05}, {"c_m", 0.4},  {"n", 0.1},
-                                    {"h_c", 0.3},   {"h_s", -0.2}, {"xi", 0.6}};
+const ParameterValues& kFreeTruth = testing_support::kFreeDecayTruth;
 // The paper's section-4 cubic estimate (MEMS ring, forced).
-const ParameterValues kForcedTruth = {
-    {"gamma", 43.029}, {"nu", 2.029},    {"b_c", 1.332},  {"b_s", -1.389}, {"c_m", 24.358},
-    {"n", 1.173},      {"h_c", -12.797}, {"h_s", 11.588}, {"u1", 32.159},  {"u2", 30.597},
-    {"u3", 1.415},     {"u4", -0.605},   {"xi", 18.217}};
-constexpr double kOmega = 85732.0;
+const ParameterValues& kForcedTruth = testing_support::kSection4Estimate;
+constexpr double kOmega = testing_support::kSection4OmegaRadS;
 
 void addNoise(std::vector<Eigen::Vector4d>* q, double sigma, unsigned seed) {
   std::mt19937 rng(seed);

@@ -6,15 +6,13 @@
 #include "cvg_bench/core/errors.h"
 #include "cvg_bench/core/identification.h"
 #include "identification_test_support.h"
+#include "paper_section4_estimate.h"
 
 namespace cvg_bench {
 namespace {
 
-const double kOmega = 85732.0;
-const ParameterValues kSection4 = {
-    {"gamma", 43.029}, {"nu", 2.029},    {"b_c", 1.332},  {"b_s", -1.389}, {"c_m", 24.358},
-    {"n", 1.173},      {"h_c", -12.797}, {"h_s", 11.588}, {"u1", 32.159},  {"u2", 30.597},
-    {"u3", 1.415},     {"u4", -0.605},   {"xi", 18.217}};
+constexpr double kOmega = testing_support::kSection4OmegaRadS;
+const ParameterValues& kSection4 = testing_support::kSection4Estimate;
 
 SweepRecord section4Sweep(int n = 61) {
   const ResonatorModel model("xi", ExperimentMode::kForced);

@@ -4,14 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include "paper_section4_estimate.h"
+
 namespace cvg_bench {
 namespace {
 
-const ParameterValues kTruth = {
-    {"gamma", 43.029}, {"nu", 2.029},    {"b_c", 1.332},  {"b_s", -1.389}, {"c_m", 24.358},
-    {"n", 1.173},      {"h_c", -12.797}, {"h_s", 11.588}, {"u1", 32.159},  {"u2", 30.597},
-    {"u3", 1.415},     {"u4", -0.605},   {"xi", 18.217}};
-constexpr double kOmega = 85732.0;
+const ParameterValues& kTruth = testing_support::kSection4Estimate;
+constexpr double kOmega = testing_support::kSection4OmegaRadS;
 constexpr double kMu = 0.2;
 
 class OutputErrorForcedTest : public ::testing::Test {

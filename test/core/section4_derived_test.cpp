@@ -6,14 +6,12 @@
 
 #include "cvg_bench/core/derived_quantities.h"
 #include "cvg_bench/core/errors.h"
+#include "paper_section4_estimate.h"
 
 namespace cvg_bench {
 namespace {
 
-const ParameterValues kSection4 = {
-    {"gamma", 43.029}, {"nu", 2.029},    {"b_c", 1.332},  {"b_s", -1.389}, {"c_m", 24.358},
-    {"n", 1.173},      {"h_c", -12.797}, {"h_s", 11.588}, {"u1", 32.159},  {"u2", 30.597},
-    {"u3", 1.415},     {"u4", -0.605},   {"xi", 18.217}};
+const ParameterValues& kSection4 = testing_support::kSection4Estimate;
 
 TEST(Section4, DerivedQuantitiesReproduceThePaper) {
   const DerivedQuantities d = deriveQuantities(kSection4, 85732.0, 0.4);

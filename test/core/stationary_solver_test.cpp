@@ -8,16 +8,14 @@
 #include <Eigen/LU>
 
 #include "cvg_bench/core/errors.h"
+#include "paper_section4_estimate.h"
 
 namespace cvg_bench {
 namespace {
 
 // The paper's section-4 cubic estimate (13 parameters, forced mode).
-const ParameterValues kPaper = {
-    {"gamma", 43.029}, {"nu", 2.029},    {"b_c", 1.332},  {"b_s", -1.389}, {"c_m", 24.358},
-    {"n", 1.173},      {"h_c", -12.797}, {"h_s", 11.588}, {"u1", 32.159},  {"u2", 30.597},
-    {"u3", 1.415},     {"u4", -0.605},   {"xi", 18.217}};
-constexpr double kOmega = 85732.0;
+const ParameterValues& kPaper = testing_support::kSection4Estimate;
+constexpr double kOmega = testing_support::kSection4OmegaRadS;
 
 TEST(StationarySolver, SolvesPaperModelAcrossSweep) {
   const ResonatorModel model("xi", ExperimentMode::kForced);

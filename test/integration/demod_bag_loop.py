@@ -17,31 +17,17 @@ import rostest
 from bag_player import BagPlayer
 from cvg_bench.msg import RawSampleBatch, SlowState
 from diagnostic_msgs.msg import DiagnosticArray
+from slow_csv_to_bag import read_csv
 
 START = rospy.Time(1700000000, 0)
 BATCH = 500
 
 
 def write_raw_bag(csv_path, bag_path):
-    meta, t, f, g = {}, [], [], []
-    header = None
-    with open(csv_path) as fh:
-        for line in fh:
-            line = line.strip()
-            if not line:
-                continue
-            if line.startswith("#"):
-                key, _, value = line[1:].partition(":")
-                meta[key.strip()] = value.strip()
-                continue
-            cells = line.split(",")
-            if header is None:
-                header = cells
-                continue
-            row = dict(zip(header, cells))
-            t.append(float(row["t"]))
-            f.append(float(row["f"]))
-            g.append(float(row["g"]))
+    meta, rows = read_csv(csv_path)
+    t = [r["t"] for r in rows]
+    f = [r["f"] for r in rows]
+    g = [r["g"] for r in rows]
     rate = round(1.0 / (t[1] - t[0]))
     with rosbag.Bag(bag_path, "w") as bag:
         for b in range(0, len(t), BATCH):

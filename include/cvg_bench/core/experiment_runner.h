@@ -49,6 +49,10 @@ struct SweepResult {
   double hysteresis_lambda_max_rad_s = 0.0;
 };
 
+/// The noise-free sweep as a record: omega0, q, direction, jump per step and the extra column
+/// `stationary` (1 settled, 0 still moving after the settle time).
+SweepRecord sweepRecordOf(const SweepResult& sweep, double omega_rad_s);
+
 class ExperimentRunner {
  public:
   /// InputError if the preset does not validate.
