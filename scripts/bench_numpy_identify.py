@@ -2,7 +2,7 @@
 """NumPy references of the batch identification, same data shapes as the C++ benchmarks of the
 same names; prints one JSON line per benchmark.
 - BM_FreeDecayBatchLinear1e6Samples: linear model (8 parameters), 10^6 slow samples: D(q) of (2.5)
-  (section 3's D_gamma with NOTES.md item 2 applied), Simpson integral over [t_{i-1}, t_{i+1}],
+  (section 3's D_gamma with docs/paper.md item 2 applied), Simpson integral over [t_{i-1}, t_{i+1}],
   y_i = 2 (q_{i+1} - q_{i-1}), least squares by numpy.linalg.lstsq (no covariance: the C++
   figure includes the honest covariance, so this ratio is conservative).
 - BM_ForcedBatch14Params1e6Points: the forced model linear+controls+xi+kappa (14 parameters,

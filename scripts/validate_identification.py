@@ -7,7 +7,7 @@ the averaged model, estimators from the core library) and summarises them:
     the ratio of the mean reported standard error to the actual RMS error (target 0.8-1.25) for
     the paper's (2.11) intervals, the identification's honest LS intervals, and Ceres;
   - forced sweeps (the paper's section-4 model, 61 points): bias of LS vs Ceres as sigma_q grows
-    (1e-3, 1e-2, 3e-2), NOTES.md item 15.
+    (1e-3, 1e-2, 3e-2), docs/paper.md item 15.
 
 Usage:
   scripts/validate_identification.py [--binary PATH] [--runs N] [--markdown docs/validation.md]

@@ -4,7 +4,7 @@
 #include <fstream>
 #include <iostream>
 
-#include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace report {

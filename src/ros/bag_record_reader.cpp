@@ -14,7 +14,7 @@
 #include <numeric>
 #include <sstream>
 
-#include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/ros/conversions.h"
 
 namespace cvg_bench {

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "cvg_bench/core/errors.h"
-#include "cvg_bench/core/resonator_model.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {
 namespace {

@@ -2,7 +2,7 @@
 #include "cvg_bench/ros/demodulator_node.h"
 
 #include "cvg_bench/SlowState.h"
-#include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/ros/conversions.h"
 
 namespace cvg_bench {

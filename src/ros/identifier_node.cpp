@@ -10,10 +10,10 @@
 #include "cvg_bench/DerivedQuantitiesStamped.h"
 #include "cvg_bench/DriftRate.h"
 #include "cvg_bench/ModelEstimate.h"
-#include "cvg_bench/core/derived_uncertainty.h"
-#include "cvg_bench/core/errors.h"
-#include "cvg_bench/core/explanation.h"
-#include "cvg_bench/core/orbit_elements.h"
+#include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/diagnose/explanation.h"
+#include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/report/explain_json.h"
 #include "cvg_bench/ros/conversions.h"
 
@@ -206,7 +206,7 @@ void IdentifierNode::identifyNow(const IdentificationOptions& options) {
                      (mode_ == ExperimentMode::kFreeDecay ? " slow states" : " sweep points") +
                      " buffered; min_samples is " + std::to_string(options_.min_samples));
   // In `rls` mode the recursive estimate streams already; the window's batch estimate is the
-  // honest least-squares one (same z at forgetting 1, NOTES.md item 9, with honest intervals).
+  // honest least-squares one (same z at forgetting 1, docs/paper.md item 9, with honest intervals).
   IdentificationOptions batch = options;
   if (batch.method == "rls") batch.method = "ls";
   Estimate e = mode_ == ExperimentMode::kFreeDecay ? identifyFreeDecay(bufferedSlowRecord(), batch)

@@ -1,7 +1,7 @@
 #include "cvg_bench/ros/identifier_node_options.h"
 
-#include "cvg_bench/core/errors.h"
-#include "cvg_bench/core/resonator_model.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {
 

@@ -7,9 +7,9 @@
 #include "cvg_bench/SimulationTruth.h"
 #include "cvg_bench/SlowState.h"
 #include "cvg_bench/SweepPoint.h"
-#include "cvg_bench/core/errors.h"
-#include "cvg_bench/core/experiment_runner.h"
-#include "cvg_bench/core/measurement_noise.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/simulate/experiment_runner.h"
+#include "cvg_bench/core/simulate/measurement_noise.h"
 #include "cvg_bench/ros/conversions.h"
 
 namespace cvg_bench {

@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cvg_bench/core/derived_uncertainty.h"
-#include "cvg_bench/core/errors.h"
-#include "cvg_bench/core/free_decay_regression.h"
-#include "cvg_bench/core/student_t.h"
+#include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/estimate/free_decay_regression.h"
+#include "cvg_bench/core/estimate/student_t.h"
 
 namespace cvg_bench {
 

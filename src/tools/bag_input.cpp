@@ -1,7 +1,7 @@
 // CSV or bag input for the tool's subcommands (see bag_input.h).
 #include "bag_input.h"
 
-#include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/model/errors.h"
 #ifdef CVG_WITH_ROSBAG
 #include "cvg_bench/ros/bag_record_reader.h"
 #endif

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "cvg_bench/core/record_io.h"
-#include "cvg_bench/core/records.h"
+#include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/io/records.h"
 
 namespace cvg_bench {
 namespace tools {

@@ -8,11 +8,11 @@
 
 #include "bag_input.h"
 #include "cli_args.h"
-#include "cvg_bench/core/demodulator.h"
-#include "cvg_bench/core/errors.h"
-#include "cvg_bench/core/frequency_estimator.h"
-#include "cvg_bench/core/irregular_demodulator.h"
-#include "cvg_bench/core/record_io.h"
+#include "cvg_bench/core/demod/demodulator.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/demod/frequency_estimator.h"
+#include "cvg_bench/core/demod/irregular_demodulator.h"
+#include "cvg_bench/core/io/record_io.h"
 #include "cvg_ident_commands.h"
 
 namespace cvg_bench {

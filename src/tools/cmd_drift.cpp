@@ -1,4 +1,4 @@
-// cvg_ident drift: the drift rate theta' of (5.9) (corrected, NOTES.md items 4-5) at a given
+// cvg_ident drift: the drift rate theta' of (5.9) (corrected, docs/paper.md item 4-5) at a given
 // (r, k, theta) or over a theta grid on [0, pi/2), from an identify JSON (or a flat parameter
 // file).
 #include <cmath>
@@ -6,10 +6,10 @@
 #include <iostream>
 
 #include "cli_args.h"
-#include "cvg_bench/core/derived_quantities.h"
-#include "cvg_bench/core/derived_uncertainty.h"
-#include "cvg_bench/core/errors.h"
-#include "cvg_bench/core/orbit_elements.h"
+#include "cvg_bench/core/estimate/derived_quantities.h"
+#include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
 

@@ -8,13 +8,13 @@
 
 #include "bag_input.h"
 #include "cli_args.h"
-#include "cvg_bench/core/ceres_refinement.h"
-#include "cvg_bench/core/demodulator.h"
-#include "cvg_bench/core/errors.h"
-#include "cvg_bench/core/frequency_estimator.h"
-#include "cvg_bench/core/identification.h"
-#include "cvg_bench/core/irregular_demodulator.h"
-#include "cvg_bench/core/record_io.h"
+#include "cvg_bench/core/estimate/ceres_refinement.h"
+#include "cvg_bench/core/demod/demodulator.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/demod/frequency_estimator.h"
+#include "cvg_bench/core/estimate/identification.h"
+#include "cvg_bench/core/demod/irregular_demodulator.h"
+#include "cvg_bench/core/io/record_io.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
 
@@ -194,7 +194,8 @@ int runIdentify(const std::vector<std::string>& argv) {
     if (want_mu) {
       IdentificationOptions lin = opt;
       std::string spec;
-      for (const auto& t : ResonatorModel(opt.model, mode).extensionNames())
+      const ResonatorModel with_mu(opt.model, mode);  // named: a temporary's names would dangle
+      for (const auto& t : with_mu.extensionNames())
         if (t != "mu") spec += (spec.empty() ? "" : "+") + t;
       lin.model = spec.empty() ? "linear" : spec;
       e = identifyForced(rec, lin);

@@ -3,10 +3,10 @@
 #include <sstream>
 
 #include "cli_args.h"
-#include "cvg_bench/core/errors.h"
-#include "cvg_bench/core/experiment_runner.h"
-#include "cvg_bench/core/record_io.h"
-#include "cvg_bench/core/resonator_preset.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/simulate/experiment_runner.h"
+#include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/model/resonator_preset.h"
 #include "cvg_ident_commands.h"
 
 namespace cvg_bench {

@@ -4,7 +4,7 @@
 #include <iostream>
 #include <map>
 
-#include "cvg_bench/core/errors.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_ident_commands.h"
 
 namespace {

@@ -8,10 +8,10 @@
 #include <iomanip>
 #include <iostream>
 
-#include "cvg_bench/core/errors.h"
-#include "cvg_bench/core/orbit_elements.h"
-#include "cvg_bench/core/output_error_free_decay.h"
-#include "cvg_bench/core/stationary_solver.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/orbit_elements.h"
+#include "cvg_bench/core/estimate/output_error_free_decay.h"
+#include "cvg_bench/core/model/stationary_solver.h"
 #include "cvg_bench/report/estimate_json.h"
 
 namespace cvg_bench {

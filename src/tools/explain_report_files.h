@@ -8,8 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "cvg_bench/core/explanation.h"
-#include "cvg_bench/core/records.h"
+#include "cvg_bench/core/diagnose/explanation.h"
+#include "cvg_bench/core/io/records.h"
 
 namespace cvg_bench {
 namespace tools {

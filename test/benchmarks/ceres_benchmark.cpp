@@ -8,8 +8,8 @@
 #include <random>
 
 #include "../core/paper_section4_estimate.h"
-#include "cvg_bench/core/ceres_refinement.h"
-#include "cvg_bench/core/output_error_free_decay.h"
+#include "cvg_bench/core/estimate/ceres_refinement.h"
+#include "cvg_bench/core/estimate/output_error_free_decay.h"
 
 namespace cvg_bench {
 namespace {

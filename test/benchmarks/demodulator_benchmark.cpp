@@ -6,8 +6,8 @@
 #include <cmath>
 #include <vector>
 
-#include "cvg_bench/core/demodulator.h"
-#include "cvg_bench/core/fir_lowpass.h"
+#include "cvg_bench/core/demod/demodulator.h"
+#include "cvg_bench/core/demod/fir_lowpass.h"
 
 namespace {
 

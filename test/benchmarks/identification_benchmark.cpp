@@ -6,8 +6,8 @@
 
 #include <random>
 
-#include "cvg_bench/core/identification.h"
-#include "cvg_bench/core/recursive_least_squares.h"
+#include "cvg_bench/core/estimate/identification.h"
+#include "cvg_bench/core/estimate/recursive_least_squares.h"
 
 namespace cvg_bench {
 namespace {

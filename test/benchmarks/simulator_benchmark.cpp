@@ -1,13 +1,13 @@
 // Simulator speed as a multiple of real time (counter x_real_time):
-//  - full equations (FastSimulator) of the mems_ring preset's forced truth model at 20 RK4 steps
+//  - full equations (FullEquationSimulator) of the mems_ring preset's forced truth model at 20 RK4 steps
 //    per period (target >= 20x real time);
-//  - the averaged model (SlowSimulator) over an hour-long ring-down of the hrg_hemispherical
+//  - the averaged model (AveragedModelSimulator) over an hour-long ring-down of the hrg_hemispherical
 //  preset.
 #include <benchmark/benchmark.h>
 
-#include "cvg_bench/core/fast_simulator.h"
-#include "cvg_bench/core/resonator_preset.h"
-#include "cvg_bench/core/slow_simulator.h"
+#include "cvg_bench/core/simulate/full_equation_simulator.h"
+#include "cvg_bench/core/model/resonator_preset.h"
+#include "cvg_bench/core/simulate/averaged_model_simulator.h"
 
 namespace cvg_bench {
 namespace {
@@ -17,10 +17,10 @@ void BM_FullEquationsMemsRing(benchmark::State& state) {
   const ResonatorPreset p = loadShippedPreset("mems_ring");
   const ExperimentMode mode = state.range(0) ? ExperimentMode::kForced : ExperimentMode::kFreeDecay;
   const ResonatorModel model(p.truthModelSpec(mode), mode);
-  FastSimulatorOptions fo;
+  FullEquationSimulatorOptions fo;
   fo.steps_per_period = 20;
   const double w = p.omega_rad_s + (state.range(0) ? 5.0 : 0.0);
-  FastSimulator sim(model, p.truthParameters(model), p.omega_rad_s, w, p.mu, {}, fo);
+  FullEquationSimulator sim(model, p.truthParameters(model), p.omega_rad_s, w, p.mu, {}, fo);
   state.SetLabel(state.range(0) ? "forced, 20 steps/period" : "free decay, 20 steps/period");
   const double simulated_s = 0.01;  // 2729 RK4 steps
   double sim_total = 0.0;
@@ -40,7 +40,7 @@ void BM_AveragedModelHrgHourRingDown(benchmark::State& state) {
   const ResonatorPreset p = loadShippedPreset("hrg_hemispherical");
   const ResonatorModel model(p.truthModelSpec(ExperimentMode::kFreeDecay),
                              ExperimentMode::kFreeDecay);
-  SlowSimulator sim(model, p.truthParameters(model));
+  AveragedModelSimulator sim(model, p.truthParameters(model));
   const double simulated_s = 3600.0;
   double sim_total = 0.0;
   for (auto _ : state) {

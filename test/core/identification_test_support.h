@@ -7,9 +7,9 @@
 #include <random>
 #include <vector>
 
-#include "cvg_bench/core/estimate.h"
-#include "cvg_bench/core/records.h"
-#include "cvg_bench/core/resonator_model.h"
+#include "cvg_bench/core/estimate/estimate.h"
+#include "cvg_bench/core/io/records.h"
+#include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {
 namespace testing_support {

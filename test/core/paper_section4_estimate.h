@@ -3,7 +3,7 @@
 // tests and benchmarks (and by config/resonators/mems_ring.yaml, checked in resonator_preset_test).
 #pragma once
 
-#include "cvg_bench/core/resonator_model.h"
+#include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {
 namespace testing_support {

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """rostest: the identifier's recursive mode. Slow states replayed from a bag are fed one by one to
-block RLS (2.12) (forgetting factor 1, corrected pairing, NOTES.md item 9); its estimate after the
+block RLS (2.12) (forgetting factor 1, corrected pairing, docs/paper.md item 9); its estimate after the
 last state equals the batch least-squares estimate the node computes when the replay stops, to
 rounding (relative 1e-8 of each value's standard error scale)."""
 import threading

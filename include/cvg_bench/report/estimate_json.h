@@ -4,8 +4,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "cvg_bench/core/estimate.h"
-#include "cvg_bench/core/resonator_model.h"
+#include "cvg_bench/core/estimate/estimate.h"
+#include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {
 namespace report {

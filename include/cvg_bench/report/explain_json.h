@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cvg_bench/core/explanation.h"
+#include "cvg_bench/core/diagnose/explanation.h"
 
 namespace cvg_bench {
 namespace report {

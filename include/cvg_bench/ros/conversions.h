@@ -22,8 +22,8 @@
 #include "cvg_bench/SimulationTruth.h"
 #include "cvg_bench/SlowState.h"
 #include "cvg_bench/SweepPoint.h"
-#include "cvg_bench/core/estimate.h"
-#include "cvg_bench/core/records.h"
+#include "cvg_bench/core/estimate/estimate.h"
+#include "cvg_bench/core/io/records.h"
 
 namespace cvg_bench {
 

@@ -18,7 +18,7 @@
 
 #include "cvg_bench/RawSampleBatch.h"
 #include "cvg_bench/Reset.h"
-#include "cvg_bench/core/demodulator.h"
+#include "cvg_bench/core/demod/demodulator.h"
 #include "cvg_bench/ros/demodulator_node_options.h"
 
 namespace cvg_bench {

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "cvg_bench/core/demodulator.h"
+#include "cvg_bench/core/demod/demodulator.h"
 #include "cvg_bench/ros/param_reader.h"
 
 namespace cvg_bench {

@@ -23,8 +23,8 @@
 #include "cvg_bench/Reset.h"
 #include "cvg_bench/SlowState.h"
 #include "cvg_bench/SweepPoint.h"
-#include "cvg_bench/core/estimate.h"
-#include "cvg_bench/core/records.h"
+#include "cvg_bench/core/estimate/estimate.h"
+#include "cvg_bench/core/io/records.h"
 #include "cvg_bench/ros/identifier_node_options.h"
 #include "cvg_bench/ros/streaming_free_decay_rls.h"
 

@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "cvg_bench/core/identification.h"
+#include "cvg_bench/core/estimate/identification.h"
 #include "cvg_bench/ros/param_reader.h"
 
 namespace cvg_bench {

@@ -13,9 +13,9 @@
 
 #include "cvg_bench/StartFreeDecay.h"
 #include "cvg_bench/StartSweep.h"
-#include "cvg_bench/core/orbit_elements.h"
-#include "cvg_bench/core/records.h"
-#include "cvg_bench/core/resonator_preset.h"
+#include "cvg_bench/core/model/orbit_elements.h"
+#include "cvg_bench/core/io/records.h"
+#include "cvg_bench/core/model/resonator_preset.h"
 #include "cvg_bench/ros/simulator_node_options.h"
 
 namespace cvg_bench {

@@ -3,7 +3,7 @@
 // from the core's forEachFreeDecayBlock), the first blocks are accumulated in the core's
 // IncrementalQr until they determine every parameter (initialisation by (2.9)), then each block is
 // one BlockRecursiveLeastSquares update. Only the core's estimators are called; this class only
-// feeds them. Intervals: the paper's sigma-hat^2 P with Student-t (2.11) (NOTES.md item 10: too
+// feeds them. Intervals: the paper's sigma-hat^2 P with Student-t (2.11) (docs/paper.md item 10: too
 // wide for free decay; the batch `identify` service gives the honest ones).
 #pragma once
 
@@ -11,11 +11,11 @@
 #include <deque>
 #include <string>
 
-#include "cvg_bench/core/estimate.h"
-#include "cvg_bench/core/identification.h"
-#include "cvg_bench/core/least_squares_solver.h"
-#include "cvg_bench/core/recursive_least_squares.h"
-#include "cvg_bench/core/resonator_model.h"
+#include "cvg_bench/core/estimate/estimate.h"
+#include "cvg_bench/core/estimate/identification.h"
+#include "cvg_bench/core/estimate/least_squares_solver.h"
+#include "cvg_bench/core/estimate/recursive_least_squares.h"
+#include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {
 

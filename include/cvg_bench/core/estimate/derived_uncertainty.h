@@ -1,0 +1,43 @@
+// Uncertainty of derived quantities by the delta method: var f(z) = J C J', J the numerical
+// Jacobian (central differences) of f at z-hat, C the estimate's covariance (the honest one).
+//  - section 4's quantities (deriveQuantities);
+//  - the drift rate theta' of (5.9) (orbit_elements.h driftRate) at (r, k, theta).
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cvg_bench/core/estimate/estimate.h"
+#include "cvg_bench/core/model/resonator_model.h"
+
+namespace cvg_bench {
+
+/// Named values with a covariance over (a subset of) them; dof 0 = normal quantile.
+struct UncertainParameters {
+  ParameterValues values;
+  std::vector<std::string> cov_names;  ///< rows/cols of covariance; empty = no covariance
+  Eigen::MatrixXd covariance;
+  int dof = 0;
+  double confidence = 0.95;
+};
+
+/// From an Estimate (values, names, covariance = the honest one, interval_dof, confidence).
+UncertainParameters uncertainParameters(const Estimate& e);
+
+/// Delta-method interval of any scalar function of the named values.
+ParameterEstimate deltaMethod(const std::function<double(const ParameterValues&)>& f,
+                              const UncertainParameters& p);
+
+/// Section 4's derived quantities with CIs (keys of DerivedQuantities::asMap()).
+std::map<std::string, ParameterEstimate> deriveQuantitiesWithIntervals(const UncertainParameters& p,
+                                                                       double omega_rad_s,
+                                                                       double angular_gain_k);
+
+/// The drift rate (5.9) [rad/s] at (r, k, theta) with its CI.
+ParameterEstimate driftRateWithInterval(double r, double k, double theta,
+                                        const UncertainParameters& p);
+
+}  // namespace cvg_bench

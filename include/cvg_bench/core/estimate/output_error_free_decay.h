@@ -1,0 +1,65 @@
+// Output-error residuals of a free-decay record (section 2) for Ceres.
+//
+// The model trajectory integrates the averaged equations (2.6), 2 q' = D(q) z, by classical RK4 on
+// the record's own time grid t_0..t_N (optionally with substeps) from the fitted initial slow
+// variables q(t_0):
+//   r_i = q_model(t_i; z, q(t_0)) - q_measured(t_i),  i = 0..N  (4 (N + 1) residuals, units of q).
+// Unlike the equation error of (2.7)-(2.8), the noisy measurement never enters the model, so the
+// residuals are the measurement noise itself, which makes Ceres' covariance honest (docs/paper.md items
+// 10, 15); noise filtered by the demodulator is correlated between samples, and a record that says
+// how (demodulator_noise.h) gets the covariance with that correlation (docs/validation.md). Derivatives: ceres::DynamicNumericDiffCostFunction, central differences
+// while iterating, Ridders' extrapolation for the final Jacobian (covariance, rank).
+#pragma once
+
+#include <ceres/cost_function.h>
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "cvg_bench/core/io/records.h"
+#include "cvg_bench/core/model/resonator_model.h"
+
+namespace cvg_bench {
+
+/// q_model at every time of t_s (t_s[0] is the start, SlowContext::t_s counts from it) by RK4 with
+/// `substeps` steps per interval. Returns false (trajectory left unfinished) when it overflows.
+bool integrateSlowTrajectory(const ResonatorModel& model, const Eigen::VectorXd& z,
+                             const Eigen::Vector4d& q0, const std::vector<double>& t_s,
+                             int substeps, std::vector<Eigen::Vector4d>* trajectory);
+
+/// The residual functor: parameter blocks (z [numParameters()], q(t_0) [4]), each in units of its
+/// scale: z = z_scale .* x_z, q(t_0) = q0_scale * x_q. Scaling makes the unknowns O(1), so the
+/// numeric-difference steps (which have absolute floors in Ceres) suit any amplitude unit (pixels,
+/// volts) and parameter size.
+class FreeDecayOutputError {
+ public:
+  /// Keeps references to model and record: both must outlive the functor. z_scale: numParameters()
+  /// positive entries (empty = all 1); q0_scale > 0.
+  FreeDecayOutputError(const ResonatorModel& model, const SlowRecord& record, int substeps,
+                       const Eigen::VectorXd& z_scale = Eigen::VectorXd(), double q0_scale = 1.0);
+  bool operator()(double const* const* parameters, double* residuals) const;
+  int numResiduals() const { return 4 * static_cast<int>(record_.size()); }
+
+ private:
+  const ResonatorModel& model_;
+  const SlowRecord& record_;
+  int substeps_;
+  Eigen::VectorXd z_scale_;
+  double q0_scale_;
+};
+
+/// How the Jacobian of the trajectory residuals is differenced.
+enum class NumericDerivative {
+  kCentral,  ///< central differences (2 trajectories per unknown, ~1e-10 relative accuracy)
+  kRidders,  ///< Ridders' extrapolation (several times dearer, ~1e-13): the final Jacobian of the
+             ///< covariance and the rank decision
+};
+
+/// The Ceres cost function over the scaled blocks (x_z, x_q) of FreeDecayOutputError.
+std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(
+    const ResonatorModel& model, const SlowRecord& record, int substeps,
+    NumericDerivative derivative = NumericDerivative::kCentral,
+    const Eigen::VectorXd& z_scale = Eigen::VectorXd(), double q0_scale = 1.0);
+
+}  // namespace cvg_bench

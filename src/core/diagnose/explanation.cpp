@@ -1,0 +1,205 @@
+#include "cvg_bench/core/diagnose/explanation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "cvg_bench/core/model/errors.h"
+
+namespace cvg_bench {
+
+std::vector<std::string> ExplainOptions::validate() const {
+  std::vector<std::string> p = fitting.validate();
+  for (const auto& s : selection.validate()) p.push_back(s);
+  if (!(lack_of_fit_alpha > 0.0 && lack_of_fit_alpha < 0.5))
+    p.push_back("lack_of_fit_alpha must lie in (0, 0.5)");
+  if (signature_stride < 3) p.push_back("signature_stride must be >= 3 (docs/paper.md item 10)");
+  if (signature_bins < 2 || signature_bins > 100) p.push_back("signature_bins must lie in 2..100");
+  return p;
+}
+
+namespace {
+
+std::string num(double v, int precision = 3) {
+  std::ostringstream s;
+  s.precision(precision);
+  s << v;
+  return s.str();
+}
+
+std::string pText(double p) {
+  if (p < 1e-12) return "p < 1e-12";
+  std::ostringstream s;
+  s.precision(2);
+  s << "p = " << p;
+  return s.str();
+}
+
+/// Runs tests of several sequences, Bonferroni-combined.
+LackOfFit combinedRuns(const std::string& what,
+                       const std::vector<std::pair<std::string, std::vector<double>>>& seqs) {
+  LackOfFit lof;
+  lof.test = what;
+  double best = 1.0;
+  for (const auto& s : seqs) {
+    const RunsTestResult r = runsTest(s.second);
+    if (r.p_value < best || lof.worst.empty()) {
+      best = std::min(best, r.p_value);
+      lof.worst = s.first + ": " + std::to_string(r.runs) + " runs of " + std::to_string(r.n) +
+                  " values, " + num(r.expected) + " expected";
+    }
+  }
+  lof.p_value = std::min(1.0, best * static_cast<double>(seqs.size()));
+  return lof;
+}
+
+std::vector<std::pair<std::string, std::vector<double>>> sequences(
+    const std::vector<BlockResidual>& blocks, int window) {
+  std::vector<std::pair<std::string, std::vector<double>>> s = {{"radial", {}}, {"tangential", {}},
+                                                                {"q1 eq.", {}}, {"p1 eq.", {}},
+                                                                {"q2 eq.", {}}, {"p2 eq.", {}}};
+  for (size_t start = 0; start + window <= blocks.size(); start += window) {
+    double sums[6] = {0, 0, 0, 0, 0, 0};
+    for (size_t i = start; i < start + window; ++i) {
+      const BlockResidual& b = blocks[i];
+      sums[0] += b.radial;
+      sums[1] += b.tangential;
+      for (int c = 0; c < 4; ++c) sums[2 + c] += b.e[c];
+    }
+    for (int c = 0; c < 6; ++c) s[c].second.push_back(sums[c]);
+  }
+  return s;
+}
+
+LackOfFit lackOfFit(ExperimentMode mode, std::vector<BlockResidual> blocks) {
+  if (mode == ExperimentMode::kForced) {
+    std::stable_sort(
+        blocks.begin(), blocks.end(),
+        [](const BlockResidual& a, const BlockResidual& b) { return a.abscissa < b.abscissa; });
+    return combinedRuns(
+        "Wald-Wolfowitz runs test of the per-point equation residuals ordered by drive frequency "
+        "(radial, tangential and the 4 components; Bonferroni over 6)",
+        sequences(blocks, 1));
+  }
+  // Trajectory residuals, decimated to at most ~200 values per sequence (demodulated records
+  // carry noise correlated over the filter length).
+  const size_t stride = std::max<size_t>(1, (blocks.size() + 199) / 200);
+  std::vector<BlockResidual> used;
+  for (size_t i = 0; i < blocks.size(); i += stride) used.push_back(blocks[i]);
+  return combinedRuns(
+      "Wald-Wolfowitz runs test of the output-error (trajectory) residuals "
+      "q_measured - q_model, every " +
+          std::to_string(stride) +
+          " sample(s) (radial, tangential and the 4 components; Bonferroni "
+          "over 6)",
+      sequences(used, 1));
+}
+
+std::string describeStep(const SelectionStep& s, const CandidateExtension& c, const Estimate& fin,
+                         double sigma_before) {
+  std::ostringstream o;
+  o << c.cause << ": " << c.parameter << " = ";
+  const auto it = fin.parameters.find(c.parameter);
+  if (it != fin.parameters.end()) {
+    o << num(it->second.value, 4) << " +/- " << num(it->second.ci_high - it->second.value, 2) << " "
+      << c.unit << " (" << num(100 * fin.confidence, 3) << " % CI)";
+  } else {
+    o << "?";
+  }
+  o << "; residual std " << num(sigma_before) << " -> " << num(s.sigma) << " ("
+    << num(s.sigma_ratio) << "x), F = " << num(s.wald.f_statistic, 4) << ", "
+    << pText(s.wald.p_value) << ", hold-out " << num(s.holdout_ratio) << "x better";
+  return o.str();
+}
+
+std::string verdict(const Explanation& x, ExperimentMode mode, const ExplainOptions& options) {
+  std::ostringstream o;
+  const SelectionResult& sel = x.selection;
+  if (sel.selected.empty()) {
+    o << "No candidate extension improves the linear model significantly";
+    const SelectionStep* best = nullptr;
+    for (const auto& s : sel.last_round)
+      if (!best || s.wald.p_value < best->wald.p_value) best = &s;
+    if (best)
+      o << " (best: " << best->added << ", " << pText(best->wald.p_value) << " against "
+        << num(best->threshold, 2) << ", hold-out ratio " << num(best->holdout_ratio) << ")";
+    o << ".";
+  } else {
+    double sigma = sel.baseline.sigma;
+    bool first = true;
+    for (const auto& s : sel.steps) {
+      if (std::find(sel.selected.begin(), sel.selected.end(), s.added) == sel.selected.end())
+        continue;
+      o << (first ? "" : " Then ")
+        << describeStep(s, findCandidateExtension(s.added, mode), x.finalEstimate(), sigma) << ".";
+      sigma = s.sigma;
+      first = false;
+    }
+  }
+  if (x.unexplained) {
+    o << " Systematic structure remains that no candidate removes: "
+      << x.final_signature.describe(options.lack_of_fit_alpha) << "; lack of fit "
+      << pText(x.lack_of_fit.p_value) << " (" << x.lack_of_fit.worst
+      << "). Look for an effect outside the library.";
+  } else {
+    o << " The " << (sel.selected.empty() ? "linear" : "final") << " model is adequate (runs test "
+      << pText(x.lack_of_fit.p_value) << ").";
+  }
+  return o.str();
+}
+
+std::vector<CandidateExtension> chosenCandidates(ExperimentMode mode,
+                                                 const ExplainOptions& options) {
+  if (options.candidates.empty()) return candidateExtensions(mode);
+  std::vector<CandidateExtension> out;
+  for (const auto& n : options.candidates) out.push_back(findCandidateExtension(n, mode));
+  return out;
+}
+
+Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
+                        const ExplainOptions& options) {
+  Explanation x;
+  x.mode = mode;
+  const auto candidates = chosenCandidates(mode, options);
+  x.selection = forwardSelect(fitter, candidates, options.selection, &x.notes);
+  const int stride = mode == ExperimentMode::kForced ? 1 : options.signature_stride;
+  x.baseline_blocks = fitter.blocks(x.selection.baseline);
+  x.final_blocks = fitter.blocks(x.selection.final_fit);
+  x.baseline_signature = residualSignature(x.baseline_blocks, mode, stride, options.signature_bins);
+  x.final_signature = residualSignature(x.final_blocks, mode, stride, options.signature_bins);
+  x.lack_of_fit = lackOfFit(mode, fitter.adequacyResiduals(x.selection.final_fit));
+  const ResidualSignature& fs = x.final_signature;
+  bool structured = false;
+  for (const auto& e : fs.entries)
+    if (e.p_value < options.lack_of_fit_alpha / std::max<size_t>(1, fs.entries.size()))
+      structured = true;
+  x.unexplained = x.lack_of_fit.p_value < options.lack_of_fit_alpha || structured;
+  x.notes.push_back("hold-out: " + x.selection.holdout_description);
+  x.cause = verdict(x, mode, options);
+  return x;
+}
+
+void throwIfInvalid(const ExplainOptions& options) {
+  const auto problems = options.validate();
+  if (problems.empty()) return;
+  std::string msg = "invalid explain options:";
+  for (const auto& p : problems) msg += " " + p + ";";
+  throw InputError(msg);
+}
+
+}  // namespace
+
+Explanation explainFreeDecay(const SlowRecord& record, const ExplainOptions& options) {
+  throwIfInvalid(options);
+  const auto fitter = makeFreeDecayFitter(record, options.fitting);
+  return explainWith(*fitter, ExperimentMode::kFreeDecay, options);
+}
+
+Explanation explainForced(const SweepRecord& record, const ExplainOptions& options) {
+  throwIfInvalid(options);
+  const auto fitter = makeForcedFitter(record, options.fitting);
+  return explainWith(*fitter, ExperimentMode::kForced, options);
+}
+
+}  // namespace cvg_bench

@@ -1,0 +1,483 @@
+#include "cvg_bench/core/estimate/ceres_refinement.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "cvg_bench/core/demod/demodulator_noise.h"
+#include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/estimate/identifiability.h"
+#include "cvg_bench/core/estimate/output_error_forced.h"
+#include "cvg_bench/core/estimate/output_error_free_decay.h"
+#include "cvg_bench/core/estimate/student_t.h"
+
+namespace cvg_bench {
+
+std::vector<std::string> CeresOptions::validate() const {
+  std::vector<std::string> p;
+  if (!(confidence > 0 && confidence < 1)) p.push_back("confidence must be in (0, 1)");
+  if (max_iterations < 1) p.push_back("max_iterations must be >= 1");
+  if (!(function_tolerance > 0)) p.push_back("function_tolerance must be > 0");
+  if (!(parameter_tolerance > 0)) p.push_back("parameter_tolerance must be > 0");
+  if (!(gradient_tolerance > 0)) p.push_back("gradient_tolerance must be > 0");
+  if (rk4_substeps < 1 || rk4_substeps > 1000) p.push_back("rk4_substeps must be in 1..1000");
+  if (!std::isfinite(known_mu)) p.push_back("known_mu must be finite");
+  if (!std::isfinite(mu_start)) p.push_back("mu_start must be finite");
+  if (!(max_dropped_fraction >= 0 && max_dropped_fraction < 1))
+    p.push_back("max_dropped_fraction must be in [0, 1)");
+  if (!(angular_gain_k > 0 && std::isfinite(angular_gain_k)))
+    p.push_back("angular_gain_k must be finite and > 0");
+  if (!(rank_tolerance > 0 && rank_tolerance < 1)) p.push_back("rank_tolerance must be in (0, 1)");
+  if (!(min_reciprocal_condition_number > 0 && min_reciprocal_condition_number < 1))
+    p.push_back("min_reciprocal_condition_number must be in (0, 1)");
+  for (const auto& s : stationary.validate()) p.push_back(s);
+  return p;
+}
+
+namespace {
+
+void requireValid(const CeresOptions& options) {
+  const auto problems = options.validate();
+  if (problems.empty()) return;
+  std::string all = "invalid Ceres options:";
+  for (const auto& s : problems) all += " " + s + ";";
+  throw InputError(all);
+}
+
+/// The start estimate's values in the model's z order (every model parameter must be present).
+Eigen::VectorXd startVector(const ResonatorModel& model, const Estimate& start) {
+  if (static_cast<int>(start.names.size()) != start.values.size())
+    throw InputError("start estimate: names and values differ in length");
+  Eigen::VectorXd z(model.numParameters());
+  for (int i = 0; i < model.numParameters(); ++i) {
+    const auto& name = model.parameterNames()[i];
+    const auto it = std::find(start.names.begin(), start.names.end(), name);
+    if (it == start.names.end())
+      throw InputError("start estimate lacks parameter '" + name + "' of model " + model.spec());
+    z[i] = start.values[it - start.names.begin()];
+  }
+  if (!z.allFinite()) throw InputError("start estimate has non-finite values");
+  return z;
+}
+
+bool modelHasMu(const ResonatorModel& model) {
+  const auto& e = model.extensionNames();
+  return std::find(e.begin(), e.end(), "mu") != e.end();
+}
+
+double startMu(const Estimate& start, const CeresOptions& options) {
+  const auto it = std::find(start.names.begin(), start.names.end(), "mu");
+  if (it != start.names.end()) {
+    const double v = start.values[it - start.names.begin()];
+    if (std::isfinite(v)) return v;
+  }
+  return options.mu_start;
+}
+
+/// What the estimate is built from once Ceres has finished.
+struct FittedProblem {
+  /// The problem whose Jacobian gives rank and covariance (may differ from the solved one only in
+  /// how derivatives are taken).
+  ceres::Problem* problem = nullptr;
+  std::vector<double*> blocks;  ///< parameter blocks, reported ones first
+  std::vector<int> block_sizes;
+  std::vector<std::string> all_names;  ///< flattened names of all unknowns
+  int n_reported = 0;                  ///< leading unknowns reported as parameters
+  /// Per flattened unknown: the blocks hold unknown / scale (empty = no scaling).
+  Eigen::VectorXd scale;
+  const std::vector<Eigen::Vector4d>* q = nullptr;  ///< measured points (excitation summary)
+  /// Free decay from a demodulator: correlation rho_l of the noise on each slow variable between
+  /// samples l apart (demodulator_noise.h); residual rows are 4 per sample, time-ordered. Empty =
+  /// white noise.
+  std::vector<double> noise_correlation;
+};
+
+void solveOrThrow(ceres::Problem* problem, const CeresOptions& options,
+                  ceres::Solver::Summary* summary) {
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = options.max_iterations;
+  so.function_tolerance = options.function_tolerance;
+  so.parameter_tolerance = options.parameter_tolerance;
+  so.gradient_tolerance = options.gradient_tolerance;
+  so.logging_type = ceres::SILENT;
+  so.minimizer_progress_to_stdout = false;
+  ceres::Solve(so, problem, summary);
+  if (!summary->IsSolutionUsable())
+    throw AnalysisError("Ceres refinement found no usable solution (" +
+                        std::string(ceres::TerminationTypeToString(summary->termination_type)) +
+                        "): " + summary->message);
+}
+
+Eigen::MatrixXd denseJacobian(const ceres::CRSMatrix& crs) {
+  Eigen::MatrixXd j = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int r = 0; r < crs.num_rows; ++r) {
+    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) j(r, crs.cols[k]) = crs.values[k];
+  }
+  return j;
+}
+
+ParameterEstimate interval(double value, double variance, double s_p) {
+  ParameterEstimate p;
+  p.value = value;
+  p.std_error = std::sqrt(std::max(variance, 0.0));
+  p.ci_low = value - s_p * p.std_error;
+  p.ci_high = value + s_p * p.std_error;
+  return p;
+}
+
+/// Rank, covariance, intervals, identifiability and derived quantities of the fitted problem.
+void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estimate* e) {
+  ceres::Problem::EvaluateOptions eo;
+  eo.parameter_blocks = fp.blocks;
+  double cost = 0.0;
+  std::vector<double> residuals;
+  ceres::CRSMatrix crs;
+  if (!fp.problem->Evaluate(eo, &cost, &residuals, nullptr, &crs))
+    throw AnalysisError("Ceres refinement: residuals cannot be evaluated at the solution");
+  Eigen::MatrixXd j = denseJacobian(crs);
+  const Eigen::VectorXd scale =
+      fp.scale.size() == j.cols() ? fp.scale : Eigen::VectorXd::Ones(j.cols());
+  j = j * scale.cwiseInverse().asDiagonal();  // with respect to the unscaled unknowns
+  if (!j.allFinite()) throw AnalysisError("Ceres refinement: non-finite Jacobian at the solution");
+  const int n = j.rows(), p = j.cols();
+
+  // Numerical rank from the column-equilibrated Jacobian (same convention as the LS estimators).
+  Eigen::VectorXd norms = j.colwise().norm().transpose();
+  for (int c = 0; c < p; ++c)
+    if (norms[c] == 0.0) norms[c] = 1.0;
+  const Eigen::MatrixXd js = j * norms.cwiseInverse().asDiagonal();
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(js, Eigen::ComputeFullV);
+  const Eigen::VectorXd s = svd.singularValues();
+  int rank = 0;
+  for (int i = 0; i < s.size(); ++i)
+    if (s[i] > options.rank_tolerance * s[0]) ++rank;
+  const int dof = n - rank;
+  if (dof < 1)
+    throw AnalysisError("Ceres refinement: no degrees of freedom left (" + std::to_string(n) +
+                        " residuals, rank " + std::to_string(rank) + ")");
+  const double sigma2 = 2.0 * cost / dof;
+
+  ceres::Covariance::Options co;
+  co.algorithm_type = ceres::DENSE_SVD;
+  co.null_space_rank = p - rank;
+  co.min_reciprocal_condition_number = options.min_reciprocal_condition_number;
+  ceres::Covariance covariance(co);
+  std::vector<const double*> cblocks(fp.blocks.begin(), fp.blocks.end());
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> cov(p, p);
+  Eigen::MatrixXd unscaled_cov;  // (J'J)^+ in the unscaled unknowns
+  if (covariance.Compute(cblocks, fp.problem) &&
+      covariance.GetCovarianceMatrix(cblocks, cov.data())) {
+    unscaled_cov = scale.asDiagonal() * Eigen::MatrixXd(cov) * scale.asDiagonal();
+  } else {
+    // ceres::Covariance refused (its condition test runs on the unequilibrated J'J): the same
+    // pseudo-inverse from the SVD of the column-equilibrated Jacobian, truncated at the rank.
+    const Eigen::MatrixXd v = svd.matrixV().leftCols(rank);
+    const Eigen::VectorXd inv_s2 = s.head(rank).cwiseAbs2().cwiseInverse();
+    unscaled_cov = norms.cwiseInverse().asDiagonal() * v * inv_s2.asDiagonal() * v.transpose() *
+                   norms.cwiseInverse().asDiagonal();
+    e->notes.push_back(
+        "covariance from the SVD of the column-equilibrated Jacobian (ceres::Covariance judged "
+        "J'J too ill-conditioned before equilibration)");
+  }
+  Eigen::MatrixXd full_cov = sigma2 * unscaled_cov;
+  std::string interval_method =
+      "output error (Ceres): sigma^2 (J'J)^+ by ceres::Covariance DENSE_SVD, Student-t";
+  if (!fp.noise_correlation.empty()) {
+    // Known noise correlation Sigma (same channel, samples l apart: rho_l): with C = (J'J)^+ and
+    // S = J' Sigma J, cov = sigma^2 C S C and E[RSS] = sigma^2 (n - tr(C S)).
+    Eigen::MatrixXd s_mat = j.transpose() * j;
+    for (size_t l = 1; l <= fp.noise_correlation.size() && 4 * static_cast<long>(l) < n; ++l) {
+      const long rows = n - 4 * static_cast<long>(l);
+      const Eigen::MatrixXd a = j.topRows(rows).transpose() * j.bottomRows(rows);
+      s_mat += fp.noise_correlation[l - 1] * (a + a.transpose());
+    }
+    const double effective_dof = n - (unscaled_cov * s_mat).trace();
+    if (effective_dof > 0.0) {
+      const double sigma2_sample = 2.0 * cost / effective_dof;  // noise variance of one sample
+      full_cov = sigma2_sample * unscaled_cov * s_mat * unscaled_cov;
+      full_cov = 0.5 * (full_cov + full_cov.transpose());
+      std::ostringstream m;
+      m.precision(3);
+      m << "output error (Ceres): sigma^2 C J' Sigma J C, C = (J'J)^+ by ceres::Covariance "
+           "DENSE_SVD, Sigma the demodulator's noise correlation (rho_1 = "
+        << fp.noise_correlation[0] << ", " << fp.noise_correlation.size()
+        << " lags; the white-noise formula is ~15 % too narrow on demodulated samples), Student-t";
+      interval_method = m.str();
+    } else {
+      e->notes.push_back(
+          "the record's noise correlation leaves no degrees of freedom (n - tr(C J' Sigma J) <= "
+          "0): white-noise covariance reported, too narrow for filtered samples");
+    }
+  }
+
+  Eigen::VectorXd x(p);
+  for (size_t b = 0, o = 0; b < fp.blocks.size(); o += fp.block_sizes[b], ++b)
+    x.segment(o, fp.block_sizes[b]) =
+        Eigen::Map<const Eigen::VectorXd>(fp.blocks[b], fp.block_sizes[b]);
+  x = x.cwiseProduct(scale);  // back to the unscaled unknowns
+
+  const int k = fp.n_reported;
+  const double s_p = studentQuantile(options.confidence, dof);
+  e->method = "ceres";
+  e->n_equations = n;
+  e->n_params = k;
+  e->rank = std::max(0, rank - (p - k));
+  e->dof = dof;
+  e->sigma = std::sqrt(sigma2);
+  e->confidence = options.confidence;
+  e->names.assign(fp.all_names.begin(), fp.all_names.begin() + k);
+  e->values = x.head(k);
+  e->covariance = full_cov.topLeftCorner(k, k);
+  e->parameters.clear();
+  for (int i = 0; i < k; ++i) e->parameters[e->names[i]] = interval(x[i], full_cov(i, i), s_p);
+  e->interval_method = interval_method;
+  e->interval_dof = dof;
+  e->covariance_paper.resize(0, 0);
+  e->parameters_paper.clear();
+  e->singular_values.assign(s.data(), s.data() + s.size());
+  e->rank_tolerance = options.rank_tolerance;
+
+  e->unidentifiable.clear();
+  e->identifiability_note.clear();
+  e->combinations.clear();
+  if (rank < p) {
+    Eigen::MatrixXd null_space =
+        norms.cwiseInverse().asDiagonal() * svd.matrixV().rightCols(p - rank);
+    null_space.colwise().normalize();
+    const IdentifiabilityReport report =
+        analyzeIdentifiability(fp.all_names, null_space, norms, summarizeExcitation(*fp.q));
+    e->unidentifiable = report.unidentifiable;
+    e->identifiability_note = report.note;
+    for (const auto& c : report.combinations) {
+      e->combinations[c.name] =
+          interval(c.coefficients.dot(x), c.coefficients.dot(full_cov * c.coefficients), s_p);
+    }
+    e->notes.push_back("rank-deficient output-error fit (rank " + std::to_string(rank) + " of " +
+                       std::to_string(p) +
+                       "): intervals of the unidentifiable parameters are not meaningful");
+  }
+
+  e->derived.clear();
+  if (options.derive_quantities && e->omega_rad_s > 0 && rank == p) {
+    try {
+      e->derived = deriveQuantitiesWithIntervals(uncertainParameters(*e), e->omega_rad_s,
+                                                 options.angular_gain_k);
+    } catch (const InputError& err) {
+      e->notes.push_back(std::string("derived quantities not computed: ") + err.what());
+    }
+  }
+}
+
+void checkTimes(const SlowRecord& record) {
+  const std::string where = record.source.empty() ? "free-decay record" : record.source;
+  if (record.q.size() != record.t_s.size())
+    throw InputError(where + ": times and slow variables differ in length");
+  for (size_t i = 0; i < record.size(); ++i) {
+    if (!std::isfinite(record.t_s[i]) || !record.q[i].allFinite())
+      throw InputError(where + ": non-finite value in sample " + std::to_string(i));
+    if (i > 0 && !(record.t_s[i] > record.t_s[i - 1]))
+      throw InputError(where + ": times not strictly increasing at sample " + std::to_string(i));
+  }
+}
+
+std::string formatQ(const double* q) {
+  std::ostringstream s;
+  s.precision(6);
+  s << "(" << q[0] << ", " << q[1] << ", " << q[2] << ", " << q[3] << ")";
+  return s.str();
+}
+
+std::string solverNote(const ceres::Solver::Summary& summary) {
+  std::ostringstream s;
+  s.precision(6);
+  s << "Ceres " << ceres::TerminationTypeToString(summary.termination_type) << " after "
+    << summary.iterations.size() - 1 << " iterations, cost " << summary.initial_cost << " -> "
+    << summary.final_cost;
+  return s.str();
+}
+
+const char* kSigmaNote =
+    "sigma is the RMS misfit of the measured slow variables (units of q), not the equation units "
+    "of the LS sigma-hat (2.10)";
+
+}  // namespace
+
+Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
+                         const CeresOptions& options) {
+  requireValid(options);
+  if (start.mode != ExperimentMode::kFreeDecay)
+    throw InputError("refineWithCeres: start estimate is not a free-decay estimate");
+  const ResonatorModel model(start.model.empty() ? "linear" : start.model,
+                             ExperimentMode::kFreeDecay);
+  checkTimes(record);
+  const int k = model.numParameters();
+  if (4 * static_cast<int>(record.size()) <= k + 4)
+    throw InputError("free-decay record has " + std::to_string(record.size()) +
+                     " samples: too few for " + std::to_string(k) +
+                     " parameters + 4 initial values");
+
+  // Unknowns scaled to O(1): z_j = z_scale_j x_j with z_scale_j = max(|start_j|, its standard
+  // error), q(t0) = q0_scale x_q with q0_scale = the record's largest |q|.
+  const Eigen::VectorXd z_start = startVector(model, start);
+  Eigen::VectorXd z_scale(k);
+  for (int i = 0; i < k; ++i) {
+    const auto it = start.parameters.find(model.parameterNames()[i]);
+    const double se = it != start.parameters.end() && std::isfinite(it->second.std_error)
+                          ? it->second.std_error
+                          : 0.0;
+    z_scale[i] = std::max(std::abs(z_start[i]), se);
+    if (!(z_scale[i] > 0)) z_scale[i] = 1.0;
+  }
+  double q0_scale = 0.0;
+  for (const auto& q : record.q) q0_scale = std::max(q0_scale, q.norm());
+  if (!(q0_scale > 0)) q0_scale = 1.0;
+  Eigen::VectorXd z = z_start.cwiseQuotient(z_scale);
+  Eigen::Vector4d q0 = record.q.front() / q0_scale;
+  ceres::Problem problem;
+  problem.AddResidualBlock(
+      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps, NumericDerivative::kCentral,
+                                   z_scale, q0_scale)
+          .release(),
+      nullptr, z.data(), q0.data());
+  ceres::Solver::Summary summary;
+  solveOrThrow(&problem, options, &summary);
+
+  Estimate e = start;
+  e.mode = ExperimentMode::kFreeDecay;
+  e.model = model.spec();
+  if (e.omega_rad_s <= 0) e.omega_rad_s = record.omega_rad_s;
+  e.notes.push_back(
+      "output-error refinement of the " +
+      (start.method.empty() ? std::string("given") : start.method) +
+      " estimate: averaged model (2.6) integrated by RK4 on the record's time grid (" +
+      std::to_string(options.rk4_substeps) +
+      " step(s) per sample interval), central numeric derivatives");
+  const Eigen::Vector4d q0_fitted = q0_scale * q0;
+  e.notes.push_back("fitted initial slow variables q(t0) = " + formatQ(q0_fitted.data()) +
+                    " (4 nuisance unknowns, not in parameters)");
+  e.notes.push_back(kSigmaNote);
+  e.notes.push_back(solverNote(summary));
+
+  // The final Jacobian by Ridders' extrapolation: central differences are good to ~1e-10, too
+  // coarse for a clean rank decision and null space.
+  ceres::Problem final_problem;
+  final_problem.AddResidualBlock(
+      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps, NumericDerivative::kRidders,
+                                   z_scale, q0_scale)
+          .release(),
+      nullptr, z.data(), q0.data());
+  FittedProblem fp;
+  fp.problem = &final_problem;
+  fp.blocks = {z.data(), q0.data()};
+  fp.block_sizes = {k, 4};
+  fp.all_names = model.parameterNames();
+  for (const char* n : {"q1_0", "p1_0", "q2_0", "p2_0"}) fp.all_names.push_back(n);
+  fp.n_reported = k;
+  fp.scale.resize(k + 4);
+  fp.scale << z_scale, Eigen::Vector4d::Constant(q0_scale);
+  fp.q = &record.q;
+  fp.noise_correlation = noiseCorrelationFromMetadata(record.metadata);
+  finishEstimate(fp, options, &e);
+  return e;
+}
+
+Estimate refineWithCeres(const SweepRecord& record, const Estimate& start,
+                         const CeresOptions& options) {
+  requireValid(options);
+  if (start.mode != ExperimentMode::kForced)
+    throw InputError("refineWithCeres: start estimate is not a forced-sweep estimate");
+  const ResonatorModel model(start.model.empty() ? "linear" : start.model, ExperimentMode::kForced);
+  const std::string where = record.source.empty() ? "forced sweep" : record.source;
+  const double omega = start.omega_rad_s > 0 ? start.omega_rad_s : record.omega_rad_s;
+  if (!(omega > 0 && std::isfinite(omega)))
+    throw InputError(where + ": natural frequency omega unknown (give --omega or '# omega:')");
+  if (record.q.size() != record.omega0_rad_s.size())
+    throw InputError(where + ": drive frequencies and slow variables differ in length");
+  for (size_t j = 0; j < record.size(); ++j) {
+    if (!(record.omega0_rad_s[j] > 0) || !std::isfinite(record.omega0_rad_s[j]) ||
+        !record.q[j].allFinite())
+      throw InputError(where + ": bad value (non-finite or omega0 <= 0) at point " +
+                       std::to_string(j));
+  }
+  const bool estimate_mu = modelHasMu(model);
+  const int k = model.numParameters();
+  const int n_unknowns = k + (estimate_mu ? 1 : 0);
+
+  Eigen::VectorXd z = startVector(model, start);
+  double mu = estimate_mu ? startMu(start, options) : options.known_mu;
+  ceres::Problem problem;
+  std::vector<Eigen::Vector4d> used_q;
+  int dropped = 0;
+  std::string first_failure;
+  for (size_t j = 0; j < record.size(); ++j) {
+    auto cost = std::make_unique<ForcedPointOutputError>(
+        model, detuningRate(omega, record.omega0_rad_s[j]), record.q[j], estimate_mu,
+        options.known_mu, options.stationary);
+    const StationaryPoint sp = cost->modelPoint(z, mu);
+    if (!sp.converged) {
+      if (first_failure.empty()) first_failure = "point " + std::to_string(j) + ": " + sp.failure;
+      ++dropped;
+      continue;
+    }
+    used_q.push_back(record.q[j]);
+    if (estimate_mu) {
+      problem.AddResidualBlock(cost.release(), nullptr, z.data(), &mu);
+    } else {
+      problem.AddResidualBlock(cost.release(), nullptr, z.data());
+    }
+  }
+  if (dropped > options.max_dropped_fraction * record.size())
+    throw AnalysisError(where +
+                        ": the stationary equations (3.3) cannot be solved at the start "
+                        "estimate for " +
+                        std::to_string(dropped) + " of " + std::to_string(record.size()) +
+                        " points (" + first_failure + ")");
+  if (4 * static_cast<int>(used_q.size()) <= n_unknowns)
+    throw InputError(where + ": " + std::to_string(used_q.size()) + " usable points: too few for " +
+                     std::to_string(n_unknowns) + " unknowns");
+  ceres::Solver::Summary summary;
+  solveOrThrow(&problem, options, &summary);
+
+  Estimate e = start;
+  e.mode = ExperimentMode::kForced;
+  e.model = model.spec();
+  e.omega_rad_s = omega;
+  e.notes.push_back(
+      "output-error refinement of the " +
+      (start.method.empty() ? std::string("given") : start.method) +
+      " estimate: model stationary points of (3.3) by Newton, analytic derivatives by the "
+      "implicit function theorem");
+  if (estimate_mu)
+    e.notes.push_back("control nonlinearity mu estimated jointly with u~ (bilinear, (3.2))");
+  else if (options.known_mu != 0.0)
+    e.notes.push_back("control nonlinearity mu = " + std::to_string(options.known_mu) + " (known)");
+  if (dropped > 0)
+    e.notes.push_back(std::to_string(dropped) +
+                      " sweep point(s) left out: no stationary solution "
+                      "at the start estimate (" +
+                      first_failure + ")");
+  e.notes.push_back(kSigmaNote);
+  e.notes.push_back(solverNote(summary));
+
+  FittedProblem fp;
+  fp.problem = &problem;
+  fp.blocks = {z.data()};
+  fp.block_sizes = {k};
+  fp.all_names = model.parameterNames();
+  if (estimate_mu) {
+    fp.blocks.push_back(&mu);
+    fp.block_sizes.push_back(1);
+    fp.all_names.push_back("mu");
+  }
+  fp.n_reported = n_unknowns;
+  fp.q = &used_q;
+  finishEstimate(fp, options, &e);
+  return e;
+}
+
+}  // namespace cvg_bench

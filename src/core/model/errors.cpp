@@ -1,0 +1,25 @@
+#include "cvg_bench/core/model/errors.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace cvg_bench {
+
+void requireFinite(double v, const std::string& what) {
+  if (!std::isfinite(v)) {
+    std::ostringstream s;
+    s << what << " must be finite, got " << v;
+    throw InputError(s.str());
+  }
+}
+
+void requirePositive(double v, const std::string& what) {
+  requireFinite(v, what);
+  if (v <= 0.0) {
+    std::ostringstream s;
+    s << what << " must be > 0, got " << v;
+    throw InputError(s.str());
+  }
+}
+
+}  // namespace cvg_bench

@@ -1,0 +1,58 @@
+// Delta-method intervals of derived quantities and of the drift rate (5.9).
+#include "cvg_bench/core/estimate/derived_uncertainty.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cvg_bench/core/model/orbit_elements.h"
+#include "cvg_bench/core/estimate/student_t.h"
+
+namespace cvg_bench {
+namespace {
+
+UncertainParameters example() {
+  UncertainParameters p;
+  p.values = {{"gamma", 43.029}, {"nu", 2.029},   {"b_c", 1.332},
+              {"b_s", -1.389},   {"c_m", 24.358}, {"n", 1.173},
+              {"h_c", -12.797},  {"h_s", 11.588}, {"xi", 18.217}};
+  for (const auto& kv : p.values) p.cov_names.push_back(kv.first);
+  const int n = static_cast<int>(p.cov_names.size());
+  p.covariance = Eigen::MatrixXd::Identity(n, n) * 0.01;
+  p.covariance(0, 1) = p.covariance(1, 0) = 0.004;  // b_c, b_s (alphabetical order of the map)
+  p.dof = 50;
+  return p;
+}
+
+TEST(DerivedUncertainty, LinearAndSimpleQuantitiesHaveTheirExactErrors) {
+  const UncertainParameters p = example();
+  const auto d = deriveQuantitiesWithIntervals(p, 85732.0, 0.4);
+  // Omega = nu / (4K): se = 0.1 / 1.6; Q = omega / gamma: se = omega / gamma^2 * 0.1.
+  EXPECT_NEAR(d.at("zero_rate_rad_s").std_error, 0.1 / 1.6, 1e-9);
+  EXPECT_NEAR(d.at("Q").std_error, 85732.0 / (43.029 * 43.029) * 0.1, 1e-6);
+  const double s = studentQuantile(0.95, 50);
+  EXPECT_NEAR(d.at("Q").ci_high - d.at("Q").value, s * d.at("Q").std_error, 1e-9);
+  // Damping anisotropy 2 sqrt(b_c^2 + b_s^2): gradient 2 (b_c, b_s) / b_m.
+  const double bm = std::hypot(1.332, -1.389);
+  const Eigen::Vector2d g(2 * 1.332 / bm, 2 * -1.389 / bm);
+  Eigen::Matrix2d c;
+  c << 0.01, 0.004, 0.004, 0.01;
+  EXPECT_NEAR(d.at("damping_anisotropy_1_s").std_error, std::sqrt(g.dot(c * g)), 1e-8);
+}
+
+TEST(DerivedUncertainty, DriftRateIntervalFollowsNu) {
+  UncertainParameters p = example();
+  // Only nu uncertain: d theta' / d nu = -1/4 exactly.
+  p.covariance.setZero();
+  int idx = -1;
+  for (int j = 0; j < static_cast<int>(p.cov_names.size()); ++j)
+    if (p.cov_names[j] == "nu") idx = j;
+  ASSERT_GE(idx, 0);
+  p.covariance(idx, idx) = 0.04;
+  const ParameterEstimate r = driftRateWithInterval(1.0, 0.05, 0.3, p);
+  EXPECT_NEAR(r.value, driftRate(1.0, 0.05, 0.3, p.values), 1e-15);
+  EXPECT_NEAR(r.std_error, 0.25 * 0.2, 1e-9);
+}
+
+}  // namespace
+}  // namespace cvg_bench
