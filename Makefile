@@ -36,3 +36,8 @@ format:
 
 clean:
 	rm -rf build
+
+# Independent validation (docs/validation_independent.md; under 30 min on 2 cores).
+.PHONY: validate
+validate: build
+	@bash scripts/validate_all.sh
