@@ -12,8 +12,8 @@ ROS_INCLUDE = re.compile(r'#\s*include\s*[<"](ros|rosbag|tf2|tf2_ros|diagnostic_
 
 class CoreBoundaries(unittest.TestCase):
     def test_no_ros_header_in_core_sources(self):
-        files = glob.glob(os.path.join(ROOT, "include", "cvg_bench", "core", "*.h"))
-        files += glob.glob(os.path.join(ROOT, "src", "core", "*.cpp"))
+        files = glob.glob(os.path.join(ROOT, "include", "cvg_bench", "core", "**", "*.h"), recursive=True)
+        files += glob.glob(os.path.join(ROOT, "src", "core", "**", "*.cpp"), recursive=True)
         self.assertGreater(len(files), 10)
         report = glob.glob(os.path.join(ROOT, "include", "cvg_bench", "report", "*.h"))
         report += glob.glob(os.path.join(ROOT, "src", "report", "*.cpp"))

@@ -308,9 +308,9 @@ ResonatorPreset loadResonatorPresetFile(const std::string& path) {
 std::string presetDirectory() {
   namespace fs = std::filesystem;
   if (const char* env = std::getenv("CVG_BENCH_PRESET_DIR")) return env;
-  // This file is <source>/src/core/resonator_preset.cpp.
-  const fs::path source_tree = fs::path(__FILE__).parent_path().parent_path().parent_path();
-  const fs::path in_tree = source_tree / "config" / "resonators";
+  // The source tree CMake compiled this library from (not __FILE__: a compiler cache may make it
+  // relative).
+  const fs::path in_tree = fs::path(CVG_BENCH_SOURCE_DIR) / "config" / "resonators";
   if (fs::is_directory(in_tree)) return in_tree.string();
   return (fs::current_path() / "config" / "resonators").string();
 }
