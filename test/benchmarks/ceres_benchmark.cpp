@@ -1,6 +1,7 @@
 // Time of the Ceres output-error refinement (--method ceres), started 5 % off the truth:
 //  - a free-decay record of 2000 samples, model linear+xi (9 parameters + 4 initial values,
-//    central numeric derivatives of RK4 trajectories);
+//    forward-sensitivity Jacobian of the RK4 trajectory), and one Jacobian evaluation by
+//    sensitivities against central differences;
 //  - a 61-point forced sweep with the paper's section-4 model (13 parameters, Newton stationary
 //    points, implicit-function derivatives), and the same with mu estimated jointly.
 #include <benchmark/benchmark.h>
@@ -47,6 +48,30 @@ void BM_CeresFreeDecay2000Samples(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(refineWithCeres(record, start));
 }
 BENCHMARK(BM_CeresFreeDecay2000Samples)->Unit(benchmark::kMillisecond);
+
+/// One residual + Jacobian evaluation of the free-decay output error (2000 samples, linear+xi):
+/// forward sensitivities against central differences (the derivative used before), same run.
+void jacobianBenchmark(benchmark::State& state, TrajectoryDerivative derivative) {
+  const ResonatorModel model("xi", ExperimentMode::kFreeDecay);
+  SlowRecord record;
+  for (int i = 0; i < 2000; ++i) record.t_s.push_back(0.002 * i);
+  const Eigen::VectorXd z = model.parameterVector(kFreeTruth);
+  const Eigen::Vector4d q0(0.8, 0.3, -0.2, 0.4);
+  integrateSlowTrajectory(model, z, q0, record.t_s, 1, &record.q);
+  const auto cost = makeFreeDecayOutputErrorCost(model, record, 1, derivative);
+  std::vector<double> r(cost->num_residuals()), jz(r.size() * z.size()), jq(r.size() * 4);
+  const double* params[] = {z.data(), q0.data()};
+  double* jac[] = {jz.data(), jq.data()};
+  for (auto _ : state) benchmark::DoNotOptimize(cost->Evaluate(params, r.data(), jac));
+}
+void BM_FreeDecayJacobianSensitivities(benchmark::State& state) {
+  jacobianBenchmark(state, TrajectoryDerivative::kSensitivity);
+}
+BENCHMARK(BM_FreeDecayJacobianSensitivities)->Unit(benchmark::kMillisecond);
+void BM_FreeDecayJacobianCentralDifferences(benchmark::State& state) {
+  jacobianBenchmark(state, TrajectoryDerivative::kCentral);
+}
+BENCHMARK(BM_FreeDecayJacobianCentralDifferences)->Unit(benchmark::kMillisecond);
 
 void sweepBenchmark(benchmark::State& state, const std::string& spec) {
   const ResonatorModel truth_model("xi", ExperimentMode::kForced);

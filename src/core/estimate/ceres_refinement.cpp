@@ -9,11 +9,11 @@
 
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/estimate/identifiability.h"
 #include "cvg_bench/core/estimate/output_error_forced.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
 #include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 
@@ -340,8 +340,8 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
   Eigen::Vector4d q0 = record.q.front() / q0_scale;
   ceres::Problem problem;
   problem.AddResidualBlock(
-      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps, NumericDerivative::kCentral,
-                                   z_scale, q0_scale)
+      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps,
+                                   TrajectoryDerivative::kSensitivity, z_scale, q0_scale)
           .release(),
       nullptr, z.data(), q0.data());
   ceres::Solver::Summary summary;
@@ -356,23 +356,16 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
       (start.method.empty() ? std::string("given") : start.method) +
       " estimate: averaged model (2.6) integrated by RK4 on the record's time grid (" +
       std::to_string(options.rk4_substeps) +
-      " step(s) per sample interval), central numeric derivatives");
+      " step(s) per sample interval), Jacobian by forward sensitivities");
   const Eigen::Vector4d q0_fitted = q0_scale * q0;
   e.notes.push_back("fitted initial slow variables q(t0) = " + formatQ(q0_fitted.data()) +
                     " (4 nuisance unknowns, not in parameters)");
   e.notes.push_back(kSigmaNote);
   e.notes.push_back(solverNote(summary));
 
-  // The final Jacobian by Ridders' extrapolation: central differences are good to ~1e-10, too
-  // coarse for a clean rank decision and null space.
-  ceres::Problem final_problem;
-  final_problem.AddResidualBlock(
-      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps, NumericDerivative::kRidders,
-                                   z_scale, q0_scale)
-          .release(),
-      nullptr, z.data(), q0.data());
+  // The final Jacobian (covariance, rank) comes from the same exact sensitivities.
   FittedProblem fp;
-  fp.problem = &final_problem;
+  fp.problem = &problem;
   fp.blocks = {z.data(), q0.data()};
   fp.block_sizes = {k, 4};
   fp.all_names = model.parameterNames();

@@ -3,9 +3,9 @@
 #include <cmath>
 
 #include "cvg_bench/core/estimate/derived_quantities.h"
+#include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
-#include "cvg_bench/core/estimate/student_t.h"
 
 namespace cvg_bench {
 

@@ -3,8 +3,8 @@
 #include <cmath>
 #include <string>
 
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/estimate/internal/regression_block_ops.h"
+#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

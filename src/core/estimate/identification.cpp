@@ -4,17 +4,17 @@
 #include <cmath>
 #include <sstream>
 
-#include "cvg_bench/core/estimate/internal/block_gram_accumulator.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/estimate/forced_regression.h"
 #include "cvg_bench/core/estimate/free_decay_noise_propagation.h"
 #include "cvg_bench/core/estimate/free_decay_regression.h"
 #include "cvg_bench/core/estimate/identifiability.h"
+#include "cvg_bench/core/estimate/internal/block_gram_accumulator.h"
+#include "cvg_bench/core/estimate/internal/regression_block_ops.h"
 #include "cvg_bench/core/estimate/least_squares_solver.h"
 #include "cvg_bench/core/estimate/recursive_least_squares.h"
-#include "cvg_bench/core/estimate/internal/regression_block_ops.h"
 #include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

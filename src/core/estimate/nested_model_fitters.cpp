@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {
@@ -154,10 +154,10 @@ class FreeDecayFitter : public NestedModelFitter {
 
  private:
   /// LS start, then the output-error (trajectory) fit: the equation-error LS of (2.8) is biased
-  /// by the noisy q inside D-bar (errors in variables) and its residuals are correlated (docs/paper.md
-  /// items 10, 15), which makes clean data look like a significant xi; the output-error residuals
-  /// are the measurement noise itself, so the Wald test on its covariance is honest. The
-  /// equation residuals (for the signature) are those of (2.8) at the refined z.
+  /// by the noisy q inside D-bar (errors in variables) and its residuals are correlated
+  /// (docs/paper.md items 10, 15), which makes clean data look like a significant xi; the
+  /// output-error residuals are the measurement noise itself, so the Wald test on its covariance is
+  /// honest. The equation residuals (for the signature) are those of (2.8) at the refined z.
   NestedFit fitOn(const SlowRecord& record, const std::vector<std::string>& extensions) const {
     IdentificationOptions o = options_.identification;
     o.model = modelSpecOf(extensions);

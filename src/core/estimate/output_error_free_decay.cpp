@@ -1,8 +1,129 @@
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
 
+#include <ceres/cost_function.h>
 #include <ceres/dynamic_numeric_diff_cost_function.h>
 
 namespace cvg_bench {
+
+namespace {
+
+constexpr int kMaxUnknowns = kMaxModelParameters + 4;
+using Sensitivity = Eigen::Matrix<double, 4, Eigen::Dynamic, 0, 4, kMaxUnknowns>;
+using Regressor = Eigen::Matrix<double, 4, Eigen::Dynamic, 0, 4, kMaxModelParameters>;
+
+/// One RK4 stage of the trajectory and its sensitivity: k = q'(q) = D(q) z / 2 and
+/// K = A(q) S + [D(q) / 2, 0] with A = slowJacobian (2.6).
+void stage(const ResonatorModel& model, const Eigen::VectorXd& z, double t,
+           const Eigen::Vector4d& q, const Sensitivity& s, Regressor* d, Eigen::Vector4d* k,
+           Sensitivity* ks) {
+  const SlowContext ctx{t, 0.0};
+  model.regressor(q, ctx, *d);
+  const int p = model.numParameters();
+  *k = 0.5 * (*d * z);
+  const Eigen::Matrix4d a = model.slowJacobian(q, ctx, z);
+  ks->noalias() = a * s;
+  ks->leftCols(p) += 0.5 * *d;
+}
+
+/// RK4 of the trajectory with its sensitivities; visit(i, q_i, S_i) at every sample.
+template <typename Visit>
+bool integrateWithSensitivities(const ResonatorModel& model, const Eigen::VectorXd& z,
+                                const Eigen::Vector4d& q0, const std::vector<double>& t_s,
+                                int substeps, Visit&& visit) {
+  if (t_s.empty()) return true;
+  const int p = model.numParameters();
+  const int m = p + 4;
+  const double t0 = t_s.front();
+  Eigen::Vector4d q = q0;
+  Sensitivity s = Sensitivity::Zero(4, m);
+  s.rightCols(4).setIdentity();
+  visit(size_t{0}, q, s);
+  Regressor d(4, p);
+  Eigen::Vector4d k1, k2, k3, k4;
+  Sensitivity s1(4, m), s2(4, m), s3(4, m), s4(4, m), tmp(4, m);
+  for (size_t i = 1; i < t_s.size(); ++i) {
+    const double h = (t_s[i] - t_s[i - 1]) / substeps;
+    double t = t_s[i - 1] - t0;
+    for (int sub = 0; sub < substeps; ++sub, t += h) {
+      stage(model, z, t, q, s, &d, &k1, &s1);
+      tmp = s + h / 2 * s1;
+      stage(model, z, t + h / 2, q + h / 2 * k1, tmp, &d, &k2, &s2);
+      tmp = s + h / 2 * s2;
+      stage(model, z, t + h / 2, q + h / 2 * k2, tmp, &d, &k3, &s3);
+      tmp = s + h * s3;
+      stage(model, z, t + h, q + h * k3, tmp, &d, &k4, &s4);
+      q += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+      s += h / 6 * (s1 + 2 * s2 + 2 * s3 + s4);
+    }
+    if (!q.allFinite() || !s.allFinite()) return false;
+    visit(i, q, s);
+  }
+  return true;
+}
+
+/// Output-error residuals with the analytic (forward-sensitivity) Jacobian over the scaled blocks
+/// (x_z, x_q) of FreeDecayOutputError.
+class FreeDecaySensitivityCost : public ceres::CostFunction {
+ public:
+  FreeDecaySensitivityCost(const ResonatorModel& model, const SlowRecord& record, int substeps,
+                           const Eigen::VectorXd& z_scale, double q0_scale)
+      : model_(model),
+        record_(record),
+        substeps_(substeps),
+        z_scale_(z_scale.size() == 0 ? Eigen::VectorXd::Ones(model.numParameters()) : z_scale),
+        q0_scale_(q0_scale) {
+    set_num_residuals(4 * static_cast<int>(record.size()));
+    mutable_parameter_block_sizes()->push_back(model.numParameters());
+    mutable_parameter_block_sizes()->push_back(4);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const int p = model_.numParameters();
+    const Eigen::VectorXd z =
+        z_scale_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(parameters[0], p));
+    const Eigen::Vector4d q0 = q0_scale_ * Eigen::Map<const Eigen::Vector4d>(parameters[1]);
+    if (jacobians == nullptr || (jacobians[0] == nullptr && jacobians[1] == nullptr))
+      return FreeDecayOutputError(model_, record_, substeps_, z_scale_, q0_scale_)(parameters,
+                                                                                   residuals);
+    return integrateWithSensitivities(
+        model_, z, q0, record_.t_s, substeps_,
+        [&](size_t i, const Eigen::Vector4d& q, const Sensitivity& s) {
+          Eigen::Map<Eigen::Vector4d>(residuals + 4 * i) = q - record_.q[i];
+          if (jacobians[0] != nullptr) {
+            Eigen::Map<Eigen::Matrix<double, 4, Eigen::Dynamic, Eigen::RowMajor>> jz(
+                jacobians[0] + 4 * i * p, 4, p);
+            jz = s.leftCols(p) * z_scale_.asDiagonal();
+          }
+          if (jacobians[1] != nullptr) {
+            Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>> jq(jacobians[1] + 16 * i);
+            jq = q0_scale_ * s.rightCols(4);
+          }
+        });
+  }
+
+ private:
+  const ResonatorModel& model_;
+  const SlowRecord& record_;
+  int substeps_;
+  Eigen::VectorXd z_scale_;
+  double q0_scale_;
+};
+
+}  // namespace
+
+bool integrateSlowSensitivities(
+    const ResonatorModel& model, const Eigen::VectorXd& z, const Eigen::Vector4d& q0,
+    const std::vector<double>& t_s, int substeps, std::vector<Eigen::Vector4d>* trajectory,
+    std::vector<Eigen::Matrix<double, 4, Eigen::Dynamic>>* sensitivity) {
+  trajectory->resize(t_s.size());
+  sensitivity->resize(t_s.size());
+  return integrateWithSensitivities(model, z, q0, t_s, substeps,
+                                    [&](size_t i, const Eigen::Vector4d& q, const Sensitivity& s) {
+                                      (*trajectory)[i] = q;
+                                      (*sensitivity)[i] = s;
+                                    });
+}
 
 bool integrateSlowTrajectory(const ResonatorModel& model, const Eigen::VectorXd& z,
                              const Eigen::Vector4d& q0, const std::vector<double>& t_s,
@@ -74,8 +195,10 @@ std::unique_ptr<ceres::CostFunction> makeCost(const ResonatorModel& model, const
 
 std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(
     const ResonatorModel& model, const SlowRecord& record, int substeps,
-    NumericDerivative derivative, const Eigen::VectorXd& z_scale, double q0_scale) {
-  if (derivative == NumericDerivative::kRidders)
+    TrajectoryDerivative derivative, const Eigen::VectorXd& z_scale, double q0_scale) {
+  if (derivative == TrajectoryDerivative::kSensitivity)
+    return std::make_unique<FreeDecaySensitivityCost>(model, record, substeps, z_scale, q0_scale);
+  if (derivative == TrajectoryDerivative::kRidders)
     return makeCost<ceres::RIDDERS>(model, record, substeps, z_scale, q0_scale);
   return makeCost<ceres::CENTRAL>(model, record, substeps, z_scale, q0_scale);
 }

@@ -44,7 +44,8 @@ void BlockRecursiveLeastSquares::update(const RegressionBlockMatrix& d, const Ei
   Eigen::Matrix4d s = p_tilde;
   s.diagonal().array() += forgetting_;
   const Eigen::LLT<Eigen::Matrix4d> llt(s);
-  const Eigen::Vector4d v = y - d * z_;  // innovation of the block being added (docs/paper.md item 9)
+  const Eigen::Vector4d v =
+      y - d * z_;  // innovation of the block being added (docs/paper.md item 9)
   const Mk4 gain = llt.solve(pr.transpose()).transpose();  // S = P r (lambda E + r'Pr)^-1
   z_.noalias() += gain * v;
   p_.noalias() -= gain * pr.transpose();

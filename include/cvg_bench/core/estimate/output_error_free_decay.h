@@ -5,10 +5,13 @@
 // variables q(t_0):
 //   r_i = q_model(t_i; z, q(t_0)) - q_measured(t_i),  i = 0..N  (4 (N + 1) residuals, units of q).
 // Unlike the equation error of (2.7)-(2.8), the noisy measurement never enters the model, so the
-// residuals are the measurement noise itself, which makes Ceres' covariance honest (docs/paper.md items
-// 10, 15); noise filtered by the demodulator is correlated between samples, and a record that says
-// how (demodulator_noise.h) gets the covariance with that correlation (docs/validation.md). Derivatives: ceres::DynamicNumericDiffCostFunction, central differences
-// while iterating, Ridders' extrapolation for the final Jacobian (covariance, rank).
+// residuals are the measurement noise itself, which makes Ceres' covariance honest (docs/paper.md
+// items 10, 15); noise filtered by the demodulator is correlated between samples, and a record that
+// says how (demodulator_noise.h) gets the covariance with that correlation (docs/validation.md).
+// Derivatives: forward sensitivities S = dq/d(z, q(t_0)) integrated by the same RK4 steps as the
+// trajectory (S' = A(q) S + [B(q), 0], A = d q'/dq = G/2, B = d q'/dz = D(q)/2 of (2.6)): the exact
+// derivative of the discrete RK4 map, one augmented integration instead of 2 per unknown.
+// Numeric differences (central, Ridders) remain available as the reference the tests compare with.
 #pragma once
 
 #include <ceres/cost_function.h>
@@ -27,6 +30,14 @@ namespace cvg_bench {
 bool integrateSlowTrajectory(const ResonatorModel& model, const Eigen::VectorXd& z,
                              const Eigen::Vector4d& q0, const std::vector<double>& t_s,
                              int substeps, std::vector<Eigen::Vector4d>* trajectory);
+
+/// The trajectory and its sensitivities at every time of t_s: (*sensitivity)[i] = d q(t_i) /
+/// d(z, q(t_0)), 4 x (numParameters() + 4), by RK4 differentiated stage by stage (exact for the
+/// discrete scheme). Returns false when the trajectory or a sensitivity overflows.
+bool integrateSlowSensitivities(const ResonatorModel& model, const Eigen::VectorXd& z,
+                                const Eigen::Vector4d& q0, const std::vector<double>& t_s,
+                                int substeps, std::vector<Eigen::Vector4d>* trajectory,
+                                std::vector<Eigen::Matrix<double, 4, Eigen::Dynamic>>* sensitivity);
 
 /// The residual functor: parameter blocks (z [numParameters()], q(t_0) [4]), each in units of its
 /// scale: z = z_scale .* x_z, q(t_0) = q0_scale * x_q. Scaling makes the unknowns O(1), so the
@@ -49,9 +60,10 @@ class FreeDecayOutputError {
   double q0_scale_;
 };
 
-/// How the Jacobian of the trajectory residuals is differenced.
-enum class NumericDerivative {
-  kCentral,  ///< central differences (2 trajectories per unknown, ~1e-10 relative accuracy)
+/// How the Jacobian of the trajectory residuals is obtained.
+enum class TrajectoryDerivative {
+  kSensitivity,  ///< forward sensitivities (exact for the RK4 map, one augmented integration)
+  kCentral,      ///< central differences (2 trajectories per unknown, ~1e-10 relative accuracy)
   kRidders,  ///< Ridders' extrapolation (several times dearer, ~1e-13): the final Jacobian of the
              ///< covariance and the rank decision
 };
@@ -59,7 +71,7 @@ enum class NumericDerivative {
 /// The Ceres cost function over the scaled blocks (x_z, x_q) of FreeDecayOutputError.
 std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(
     const ResonatorModel& model, const SlowRecord& record, int substeps,
-    NumericDerivative derivative = NumericDerivative::kCentral,
+    TrajectoryDerivative derivative = TrajectoryDerivative::kSensitivity,
     const Eigen::VectorXd& z_scale = Eigen::VectorXd(), double q0_scale = 1.0);
 
 }  // namespace cvg_bench
