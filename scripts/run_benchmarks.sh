@@ -28,10 +28,16 @@ for script in scripts/bench_numpy_*.py; do
     echo "run_benchmarks: $script failed" >&2
   }
 done
-/usr/bin/python3 - "$out/cpp.json" "$out/numpy.jsonl" "$root/docs/benchmarks.md" "$reps" <<'PY'
+sizes="${CVG_BENCH_SCALING_SIZES:-1000,10000,100000}"
+echo "run_benchmarks: scripts/bench_explain_scaling.py --sizes $sizes"
+/usr/bin/python3 scripts/bench_explain_scaling.py --sizes "$sizes" > "$out/scaling.jsonl" || {
+  echo "run_benchmarks: bench_explain_scaling.py failed" >&2
+}
+/usr/bin/python3 - "$out/cpp.json" "$out/numpy.jsonl" "$root/docs/benchmarks.md" "$reps" \
+  "$out/scaling.jsonl" <<'PY'
 import datetime, json, subprocess, sys
 
-cpp_path, numpy_path, md_path, REPS = sys.argv[1:5]
+cpp_path, numpy_path, md_path, REPS, scaling_path = sys.argv[1:6]
 cpp = json.load(open(cpp_path))
 numpy = {}
 for line in open(numpy_path):
@@ -107,7 +113,22 @@ for name, b in by_name.items():
 extra = [n for n in numpy if n not in by_name]
 for n in extra:
     lines.append("| %s (NumPy only) | | | | %s | | |" % (n, si(numpy[n]["items_per_second"])))
-lines += ["", "Items: see each benchmark's comment (demodulator: f,g sample pairs).", ""]
+lines += ["", "Items: see each benchmark's comment (demodulator: f,g sample pairs). The demodulator's "
+          "NumPy reference is the fastest of three variants that compute only the kept outputs or "
+          "all of them (scripts/bench_numpy_demod.py; each variant is listed as NumPy only).", ""]
+
+scaling = [json.loads(l) for l in open(scaling_path) if l.startswith("{")]
+if scaling:
+    lines += ["## explain and Ceres identify against record length", "",
+              "scripts/bench_explain_scaling.py: hrg_hemispherical free decay with xi hidden, one run "
+              "each (whole process: reading, fitting, printing), CPU time and peak resident memory.",
+              "", "| command | slow samples | exit | CPU time | peak RSS | RSS per sample |",
+              "|---|---|---|---|---|---|"]
+    for r in scaling:
+        lines.append("| %s | %d | %d | %.2f s | %.0f MB | %.0f B |" % (
+            r["name"].split("/")[0], r["samples"], r["exit"], r["cpu_s"],
+            r["peak_rss_bytes"] / 1e6, r["bytes_per_sample"]))
+    lines.append("")
 
 # The issues' targets against this run (medians).
 
