@@ -1,5 +1,7 @@
 """The core library stays ROS-free: no ROS header in its sources (nor in the JSON report library's),
-no catkin library on its link line."""
+no catkin library on its link line; and its stage folders depend only downwards:
+model <- io <- simulate, demod <- estimate <- diagnose (a stage includes its own folder and the
+stages before it; estimate/internal/ holds kernels any stage may use)."""
 import glob
 import os
 import re
@@ -10,7 +12,40 @@ ROS_INCLUDE = re.compile(r'#\s*include\s*[<"](ros|rosbag|tf2|tf2_ros|diagnostic_
                          r'geometry_msgs|cvg_bench/ros|cvg_bench/[A-Z]\w*\.h)')
 
 
+STAGE_ORDER = ["model", "io", "simulate", "demod", "estimate", "diagnose"]
+ALLOWED = {
+    "model": {"model"},
+    "io": {"model", "io"},
+    "simulate": {"model", "io", "simulate"},
+    "demod": {"model", "io", "demod"},
+    "estimate": {"model", "io", "demod", "estimate"},
+    "diagnose": {"model", "io", "demod", "estimate", "diagnose"},
+}
+CORE_INCLUDE = re.compile(r'#\s*include\s*"cvg_bench/core/([a-z_]+)/(internal/)?')
+
+
 class CoreBoundaries(unittest.TestCase):
+    def test_stages_depend_only_downwards(self):
+        offenders = []
+        seen = set()
+        for stage in STAGE_ORDER:
+            files = glob.glob(os.path.join(ROOT, "include", "cvg_bench", "core", stage, "**", "*.h"),
+                              recursive=True)
+            files += glob.glob(os.path.join(ROOT, "src", "core", stage, "**", "*.cpp"), recursive=True)
+            if files:
+                seen.add(stage)
+            for path in files:
+                with open(path, encoding="utf-8") as f:
+                    for n, line in enumerate(f, 1):
+                        m = CORE_INCLUDE.search(line)
+                        if m and m.group(1) not in ALLOWED[stage] and not m.group(2):
+                            offenders.append("%s:%d: %s" % (os.path.relpath(path, ROOT), n, line.strip()))
+        self.assertEqual(seen, set(STAGE_ORDER))
+        loose = glob.glob(os.path.join(ROOT, "src", "core", "*.cpp"))
+        loose += glob.glob(os.path.join(ROOT, "include", "cvg_bench", "core", "*.h"))
+        self.assertEqual(loose, [], "core files outside a stage folder")
+        self.assertEqual(offenders, [])
+
     def test_no_ros_header_in_core_sources(self):
         files = glob.glob(os.path.join(ROOT, "include", "cvg_bench", "core", "**", "*.h"), recursive=True)
         files += glob.glob(os.path.join(ROOT, "src", "core", "**", "*.cpp"), recursive=True)

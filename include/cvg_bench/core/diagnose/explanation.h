@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "cvg_bench/core/diagnose/forward_selection.h"
-#include "cvg_bench/core/estimate/nested_model_fitters.h"
+#include "cvg_bench/core/diagnose/nested_model_fitters.h"
 #include "cvg_bench/core/io/records.h"
 #include "cvg_bench/core/diagnose/residual_signature.h"
 

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/nested_model_fitters.h"
+#include "cvg_bench/core/diagnose/nested_model_fitters.h"
 
 #include <Eigen/QR>
 #include <algorithm>
