@@ -36,6 +36,7 @@ import json
 import math
 import multiprocessing
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -131,7 +132,7 @@ def noisy_record(case, work):
         records.write_sweep(path, p["omega"], d["x"], noise.noisy_slow(d["q"], case["noise"],
                                                                         p["sigma"], rng))
     else:
-        f, g = noise.noisy_raw(d["f"], d["g"], case["noise"], p["sigma"], rng)
+        f, g = noise.noisy_raw(d["f"], d["g"], case["noise"], p["sigma"], rng, p["omega"], d["x"])
         records.write_raw(path, p["omega"], d["x"], f, g)
     return path, z, p["omega"]
 
@@ -152,7 +153,7 @@ def run_tool(cmd, timeout=600):
 def verdict(case, selected, unexplained):
     hidden, outside = set(case["hidden"]), case["outside"]
     if outside:
-        stand_in = presets.OUTSIDE[MODE[case["kind"]]][outside]
+        stand_in = case["stand_in"]
         correct = unexplained or (stand_in is not None and set(selected) == {stand_in})
     else:
         correct = set(selected) == hidden and not unexplained
@@ -211,32 +212,52 @@ def label(hidden, outside):
     return outside if outside else ("+".join(hidden) if hidden else "none")
 
 
-def explain_cases(kind, quick):
+def tool_terms(tool):
+    """Newer library terms (presets.NEWER_TERMS) that this tool's `explain --help` names."""
+    try:
+        text = subprocess.run([tool, "explain", "--help"], stdout=subprocess.PIPE,
+                              stderr=subprocess.STDOUT, universal_newlines=True).stdout
+    except OSError:
+        return []
+    return [t for t in presets.NEWER_TERMS if re.search(r"\b%s\b" % re.escape(t), text)]
+
+
+def tool_version(tool):
+    """The git commit the tool was built from (the repository's HEAD)."""
+    try:
+        return subprocess.run(["git", "-C", os.path.dirname(os.path.abspath(tool)), "rev-parse",
+                               "--short", "HEAD"], stdout=subprocess.PIPE,
+                              stderr=subprocess.DEVNULL, universal_newlines=True).stdout.strip()
+    except OSError:
+        return "?"
+
+
+def explain_cases(kind, quick, terms=()):
     mode = MODE[kind]
-    lib = presets.LIBRARY[mode]
+    lib, outside_effects = presets.library(mode, terms)
     configs = [([], None)] + [([a], None) for a in lib]
     configs += [(list(p), None) for p in itertools.combinations(lib, 2)]
-    configs += [([], o) for o in presets.OUTSIDE[mode]]
+    configs += [([], o) for o in outside_effects]
     table = {"fd_slow": presets.FREE_DECAY, "sweep": presets.SWEEP, "fd_raw": presets.RAW}[kind]
     models = list(noise.NOISE_MODELS)
     cases = []
-    if kind == "fd_raw":
-        models = ["white", "white+gain_drift"]
-        pairs = [("xi", "kappa"), ("xi", "gamma_nl"), ("kappa", "cm_rate"),
-                 ("gamma_nl", "xi_diff"), ("xi_diff", "cm_rate")]
-        configs = [c for c in configs if len(c[0]) < 2 or tuple(c[0]) in pairs]
-    for preset in table:
+    if kind == "fd_raw":  # raw: white, narrow-band AR(1) around the carrier, gain drift
+        models = ["white", "ar1_0.9", "white+gain_drift"]
+    for pi, preset in enumerate(table):
         for ci, (hidden, outside) in enumerate(configs):
             reps, use = 1, models
             if not hidden and not outside:
                 reps = {"fd_raw": 5, "fd_slow": 3, "sweep": 4}[kind]  # more clean runs
             elif kind == "fd_slow" and len(hidden) == 2:
                 use = models[ci % 2::2]  # pairs: two of the four noise models, alternating
+            elif kind == "fd_raw" and len(hidden) == 2:  # pairs: one noise model, rotating
+                use = [models[(ci + pi) % len(models)]]
             for m in use:
                 for _ in range(reps):
                     cases.append(dict(kind=kind, preset=preset, noise=m,
                                       hidden=hidden + ([outside] if outside else []),
-                                      outside=outside, label=label(hidden, outside)))
+                                      outside=outside, label=label(hidden, outside),
+                                      stand_in=outside_effects.get(outside)))
     if quick:
         pick = {"fd_slow": [("fd_cyl_40s", "none", "white"), ("fd_mems_3s", "xi+kappa", "ar1_0.9")],
                 "sweep": [("sw_ring_24k", "none", "ar1_0.9"), ("sw_ring_11k", "gamma_nl+mu", "white")],
@@ -464,11 +485,14 @@ def main():
         print("validate_independent: the generator's self-check FAILED; no validation run")
         return 2
     cases = []
+    terms = args.terms = tool_terms(args.tool)
+    print("library terms beyond the original ten that the tool names: %s" % (
+        ", ".join(terms) or "none"))
     for kind in kinds:
         if kind.startswith("cov_"):
             cases += coverage_cases(kind, 3 if args.quick else args.coverage_runs)
         else:
-            cases += explain_cases(kind, args.quick)
+            cases += explain_cases(kind, args.quick, terms)
     for i, c in enumerate(cases):
         c["seed"] = SEED0 + i
     if args.quick:  # the smoke subset: explain cases, plus at most 1 coverage pair
@@ -521,7 +545,8 @@ def main():
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(dict(results=results, elapsed_s=elapsed, quick=args.quick,
-                           selfcheck="ok", kinds=kinds), fh, indent=1, default=str)
+                           selfcheck="ok", kinds=kinds, library_terms_beyond_ten=terms), fh,
+                      indent=1, default=str)
     if args.markdown:
         with open(args.markdown, "w") as fh:
             fh.write("\n".join(report_header(args, elapsed, len(results)) + lines) + "\n")
@@ -589,16 +614,22 @@ solved for stationary points by Newton with continuation over the detuning (swee
 the full equations (2.3) integrated by solve_ivp DOP853 in f, f', g, g' and demodulated by the
 tool itself. Own presets (below), other sample steps and record lengths, noise white, AR(1)
 rho 0.5 / 0.9 on q (independent per channel; for sweeps along the sweep), or white with a slow
-pick-off gain drift (+0.3 % on f, -0.2 % on g over the record). The tool is not told what was
-hidden, nor the noise.
+pick-off gain drift (+0.3 % on f, -0.2 % on g over the record); raw records: white, narrow-band
+noise around the carrier (a cos + b sin with a, b AR(1) rho 0.9 per raw sample, coloured after
+demodulation), or the gain drift. The tool is not told what was hidden, nor the noise.
 
 Data kinds: fd_slow (free decay t,q1,p1,q2,p2), sweep (omega0,q1,p1,q2,p2), fd_raw (t,f,g through
 the tool's demodulator). Hidden: nothing (clean), one library term, every pair of library terms
 (free decay: xi, kappa, gamma_nl, xi_diff, cm_rate; forced: xi, kappa, gamma_nl, xi_diff, mu;
-fd_raw: the singles and 5 pairs), or an effect outside the library: gamma_nl4 (damping
--gamma_nl4 (f^2+g^2)^2 f'), cm_step (a saturating frequency transient c_m + d (1 - exp(-t/tau))),
-delay (the drive arrives delayed: its phase turns with omega0 across the sweep), pump (the
-2 omega0 parametric terms of (2.1), docs/paper.md item 6).
+fd_slow pairs under two of the four noise models, fd_raw pairs under one of its three, rotating),
+or an effect outside the library: gamma_nl4 (damping -gamma_nl4 (f^2+g^2)^2 f'), cm_step (a
+saturating frequency transient c_m + d (1 - exp(-t/tau))), delay (the drive arrives delayed: its
+phase turns with omega0 across the sweep), pump (the 2 omega0 parametric terms of (2.1),
+docs/paper.md item 6). The second isotropic cubic invariant xi_k (F_f = -(xi_k/(2 omega)) l g',
+F_g = +(xi_k/(2 omega)) l f', l = f g' - g f'; same precession coupling r k / 8 as xi, no
+amplitude-frequency law of its own on a standing wave) is a library term when the tool's
+`explain --help` names it (then also in every pair), otherwise an effect outside the library
+with no stand-in.
 
 Scoring, fixed in the script before running: **correct** = the selected set equals the hidden
 set and `unexplained` is false; for an effect outside the library, correct = `unexplained: true`
@@ -614,10 +645,11 @@ are Wilson 95 % (scipy.stats.binomtest). Seeds 50000 + run index.
 def report_header(args, elapsed, n):
     return [DOC_INTRO, "<!-- written by scripts/validate_independent.py -->",
             "Measured %s, command `/usr/bin/python3 scripts/validate_independent.py%s%s` "
-            "(%d runs, %.0f s on %d worker processes)." % (
+            "(%d runs, %.0f s on %d worker processes; tool %s, library terms beyond the original ten "
+            "that it names: %s)." % (
                 time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), " --quick" if args.quick else "",
                 "" if args.kinds == ",".join(KINDS) else " --kinds " + args.kinds, n, elapsed,
-                args.jobs), ""] + setup_text() + [""]
+                args.jobs, tool_version(args.tool), ", ".join(args.terms) or "none"), ""] + setup_text() + [""]
 
 
 if __name__ == "__main__":

@@ -71,7 +71,7 @@ def stationary_sweep(z, omega, omega0s):
     from the previous one, the step is halved where the solver does not converge. Returns the
     points and, per point, whether it is stable (Jacobian eigenvalues with negative real part)."""
     lin = {k: v for k, v in z.items() if k not in ("xi", "kappa", "xi_diff", "gamma_nl", "mu",
-                                                     "gamma_nl4", "eta_pump")}
+                                                     "gamma_nl4", "eta_pump", "xi_k")}
     # linear start: the averaged model is affine in q, rhs(q) = A q + b
     zz = lin
     b = rhs(zz, omega, 0.0, np.zeros(4), omega0s[0])

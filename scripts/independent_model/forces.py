@@ -4,6 +4,10 @@ A truth is a dict of coefficients (plain names, tilde = divided by omega as in t
   linear (2.3): gamma, nu, b_c, b_s, c_m, n, h_c, h_s
   library extensions: xi (cubic, (2.3)), kappa (quintic, (2.3)), gamma_nl (-gamma_nl N f'),
     xi_diff (+xi_diff N f on f, -xi_diff N g on g), cm_rate (c_m(t) = c_m + cm_rate t)
+  the second isotropic cubic invariant xi_k (library term of newer tools, outside the library of
+    older ones): F_f = -(xi_k/(2 omega)) l g', F_g = +(xi_k/(2 omega)) l f' with the angular
+    momentum l = f g' - g f'; it leaves a standing wave (l = 0) alone and adds xi_k r k / 8 to the
+    averaged precession theta' of (5.9), as xi does (docs/paper.md item 4)
   drive (3.1): u1..u4 (u~ = eta u / omega), mu, at drive phase theta = omega0 t
   outside the library (not in the tool's model):
     gamma_nl4   -gamma_nl4 N^2 f' (damping growing with amplitude^4)
@@ -36,6 +40,11 @@ def force(z, omega, t, f, fd, g, gd, theta=None):
     xi, xd, ka = z.get("xi", 0.0), z.get("xi_diff", 0.0), z.get("kappa", 0.0)
     ff = ff + w * (xi + xd) * nn * f + w * ka * nn * nn * f
     fg = fg + w * (xi - xd) * nn * g + w * ka * nn * nn * g
+    xk = z.get("xi_k", 0.0)
+    if xk:
+        ell = f * gd - g * fd
+        ff = ff - xk / (2.0 * w) * ell * gd
+        fg = fg + xk / (2.0 * w) * ell * fd
     damp_nl = z.get("gamma_nl", 0.0) * nn + z.get("gamma_nl4", 0.0) * nn * nn
     ff = ff - damp_nl * fd
     fg = fg - damp_nl * gd

@@ -2,6 +2,7 @@
 marginal std sigma, q_k = rho q_{k-1} + sqrt(1 - rho^2) sigma e_k), and a slow pick-off gain drift
 (the f channel's gain ramps by gain_f over the record, the g channel's by gain_g)."""
 import numpy as np
+from scipy.signal import lfilter
 
 NOISE_MODELS = {
     "white": dict(rho=0.0, gain=(0.0, 0.0)),
@@ -15,12 +16,9 @@ def ar1(rng, n, cols, rho, sigma):
     e = rng.standard_normal((n, cols)) * sigma
     if rho == 0.0:
         return e
-    out = np.empty_like(e)
-    out[0] = e[0]
-    s = np.sqrt(1.0 - rho * rho)
-    for k in range(1, n):
-        out[k] = rho * out[k - 1] + s * e[k]
-    return out
+    # out_k = rho out_{k-1} + sqrt(1 - rho^2) e_k, out_0 = e_0 (stationary from the start)
+    e[1:] *= np.sqrt(1.0 - rho * rho)
+    return lfilter([1.0], [1.0, -rho], e, axis=0)
 
 
 def gain_ramp(n, gain):
@@ -37,10 +35,16 @@ def noisy_slow(q, model, sigma, rng):
     return out + ar1(rng, len(q), 4, m["rho"], sigma)
 
 
-def noisy_raw(f, g, model, sigma, rng):
-    """Raw f, g: white noise of std sigma (AR(1) on raw samples is not a slow-noise model; the
-    coloured case of raw records is the demodulator's own filtering) and the gain drift."""
+def noisy_raw(f, g, model, sigma, rng, omega, t):
+    """Raw f, g with the gain drift and noise of std sigma: white per raw sample, or (rho > 0)
+    narrow-band noise around the carrier, a cos(omega t) + b sin(omega t) with a, b AR(1) per raw
+    sample (the noise the slow variables q, p see is then coloured after demodulation)."""
     m = NOISE_MODELS[model]
     gf, gg = gain_ramp(len(f), m["gain"])
-    e = rng.standard_normal((len(f), 2)) * sigma
+    if m["rho"] == 0.0:
+        e = rng.standard_normal((len(f), 2)) * sigma
+    else:
+        ab = ar1(rng, len(f), 4, m["rho"], sigma)
+        c, s = np.cos(omega * t), np.sin(omega * t)
+        e = np.column_stack([ab[:, 0] * c + ab[:, 1] * s, ab[:, 2] * c + ab[:, 3] * s])
     return f * gf + e[:, 0], g * gg + e[:, 1]

@@ -59,9 +59,21 @@ SWEEP = {
 # "unexplained" is correct).
 LIBRARY = {"free_decay": ["xi", "kappa", "gamma_nl", "xi_diff", "cm_rate"],
            "forced": ["xi", "kappa", "gamma_nl", "xi_diff", "mu"]}
-OUTSIDE = {"free_decay": {"gamma_nl4": "gamma_nl", "cm_step": "cm_rate"},
-           "forced": {"delay": None, "pump": None}}
+OUTSIDE = {"free_decay": {"gamma_nl4": "gamma_nl", "cm_step": "cm_rate", "xi_k": None},
+           "forced": {"delay": None, "pump": None, "xi_k": None}}
+# Terms the generator knows that newer tools add to their library: scored as library terms when
+# the tool's `explain --help` names them, as effects outside the library (no stand-in) otherwise.
+NEWER_TERMS = ["xi_k"]
 
+
+def library(mode, tool_terms=()):
+    """(library terms, outside effects with stand-ins) for a tool that knows tool_terms."""
+    lib = LIBRARY[mode] + [t for t in NEWER_TERMS if t in tool_terms]
+    out = {k: v for k, v in OUTSIDE[mode].items() if k not in lib}
+    return lib, out
+
+# xi_k (added later): xi's size times SE(xi_k)/SE(xi) of a Fisher-information fit of the averaged
+# model with the linear terms, xi and xi_k (and the initial state) to the clean preset record.
 # Effect sizes per preset, about 12 standard errors of the clean record fitted with the whole
 # library (pilot of 2026-11-23, white noise; mu from a Ceres fit of xi+mu). Outside the library:
 # gamma_nl4 with the same decay-rate change at amplitude 0.7 as gamma_nl, cm_step the same total
@@ -70,19 +82,19 @@ OUTSIDE = {"free_decay": {"gamma_nl4": "gamma_nl", "cm_step": "cm_rate"},
 # of c_m.
 EFFECTS = {
     "fd_hrg_1h": dict(xi=6.6e-4, kappa=5.4e-4, gamma_nl=3.4e-4, xi_diff=2.3e-4, cm_rate=4.6e-8,
-                      gamma_nl4=6.9e-4, cm_step=1.7e-4),
+                      gamma_nl4=6.9e-4, cm_step=1.7e-4, xi_k=3.1e-3),
     "fd_cyl_40s": dict(xi=0.13, kappa=0.15, gamma_nl=0.34, xi_diff=0.085, cm_rate=5.7e-3,
-                       gamma_nl4=0.69, cm_step=0.23),
+                       gamma_nl4=0.69, cm_step=0.23, xi_k=1.75),
     "fd_mems_3s": dict(xi=3.9, kappa=4.6, gamma_nl=2.5, xi_diff=1.7, cm_rate=0.36,
-                       gamma_nl4=5.1, cm_step=1.1),
+                       gamma_nl4=5.1, cm_step=1.1, xi_k=24.0),
     "raw_1k2": dict(xi=7.9, kappa=8.2, gamma_nl=2.9, xi_diff=1.75, cm_rate=1.45, gamma_nl4=5.8,
-                    cm_step=1.45),
+                    cm_step=1.45, xi_k=38.0),
     "raw_700": dict(xi=3.6, kappa=3.1, gamma_nl=1.0, xi_diff=0.73, cm_rate=0.45, gamma_nl4=2.0,
-                    cm_step=0.9),
+                    cm_step=0.9, xi_k=17.0),
     "sw_ring_11k": dict(xi=24.0, kappa=15.0, gamma_nl=8.8, xi_diff=16.0, mu=0.026, delay=7.5e-4,
-                        pump=2.3e6),
+                        pump=2.3e6, xi_k=85.0),
     "sw_ring_24k": dict(xi=10.0, kappa=9.0, gamma_nl=3.6, xi_diff=5.0, mu=0.016, delay=1.0e-3,
-                        pump=6.1e6),
+                        pump=6.1e6, xi_k=34.0),
 }
 
 

@@ -31,6 +31,23 @@ def _compact_nonlinear(xi, kappa, q):
     return np.array([out[0].real, out[0].imag, out[1].real, out[1].imag])
 
 
+def _orbit(q):
+    """Orbit elements of (5.1): r, k from the ellipse q1,p1 / q2,p2 (r the major semi-axis, r k
+    the determinant) and the pattern angle theta of the major axis."""
+    m = np.array([[q[0], q[1]], [q[2], q[3]]])
+    r = np.linalg.svd(m, compute_uv=False)[0]
+    th = 0.5 * np.arctan2(2 * (q[0] * q[2] + q[1] * q[3]),
+                          q[0] ** 2 + q[1] ** 2 - q[2] ** 2 - q[3] ** 2)
+    return r, np.linalg.det(m) / r, th
+
+
+def _orbit_rates(z, omega, q, h=1e-6):
+    """r', k', theta' of the averaged model at q (central difference along q')."""
+    dq = averaged.rhs(z, omega, 0.0, q)
+    a, b = _orbit(q - h * dq), _orbit(q + h * dq)
+    return [(y - x) / (2 * h) for x, y in zip(a, b)]
+
+
 Z = dict(gamma=0.8, nu=0.05, b_c=0.07, b_s=-0.04, c_m=0.5, n=0.1, h_c=0.3, h_s=-0.2)
 
 
@@ -48,6 +65,20 @@ def checks(fast=True):
                                            - _compact_nonlinear(0.7, -0.4, q))))
     res.append(("averaged linear part = (2.5) rows", err_lin, 1e-12))
     res.append(("averaged cubic+quintic = compact form (item 1)", err_nl, 1e-12))
+    # (1b) the second cubic invariant xi_k: the same precession rate as xi at equal coefficient
+    # (both enter theta' of (5.9) as coefficient r k / 8, docs/paper.md item 4), r and k unchanged,
+    # and no effect at all on a standing wave (k = 0)
+    err_prec = err_rk = 0.0
+    for _ in range(5):
+        q = rng.normal(size=4)
+        rk_xi = _orbit_rates({"xi": 0.7}, omega, q)
+        rk_k = _orbit_rates({"xi_k": 0.7}, omega, q)
+        err_prec = max(err_prec, abs(rk_k[2] - rk_xi[2]) / abs(rk_xi[2]))
+        err_rk = max(err_rk, abs(rk_k[0]), abs(rk_k[1]))
+    res.append(("xi_k: precession rate = xi's at equal coefficient (relative)", err_prec, 1e-5))
+    res.append(("xi_k: r' and k' vanish", err_rk, 1e-8))
+    res.append(("xi_k: no force on a standing wave", np.max(np.abs(averaged.rhs(
+        {"xi_k": 0.7}, omega, 0.0, np.array([0.6, 0.2, 0.3, 0.1])))), 1e-14))
     # (2) linear free decay with only gamma: q(t) = q0 exp(-gamma t / 2)
     t = np.linspace(0.0, 3.0, 31)
     q0 = np.array([0.3, 0.9, 0.2, -0.1])
@@ -72,7 +103,7 @@ def checks(fast=True):
     # (4) full equations vs averaged: the difference is first order in eps = gamma/omega, so it
     # halves when omega doubles (checked with a cubic term, i.e. nonlinear and anisotropic case)
     diffs = []
-    zc = dict(Z, xi=0.6)
+    zc = dict(Z, xi=0.6, xi_k=0.4)
     for om in ((2 * np.pi * 40.0, 2 * np.pi * 80.0) if fast else (2 * np.pi * 80.0, 2 * np.pi * 160.0)):
         tt, f, g = full.raw_free_decay(zc, om, q0, 1.0, 40 * om / (2 * np.pi), rtol=1e-11)
         qa = averaged.free_decay(zc, om, q0, tt)
