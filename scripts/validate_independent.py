@@ -37,10 +37,12 @@ import math
 import multiprocessing
 import os
 import re
+import resource
 import subprocess
 import sys
 import tempfile
 import time
+import zlib
 
 import numpy as np
 from scipy.stats import binomtest
@@ -96,7 +98,7 @@ def make_trajectory(args):
     path = os.path.join(work, "traj_" + traj_key(kind, preset, hidden) + ".npz")
     if os.path.exists(path):
         return path, 0.0, ""
-    t0 = time.time()
+    t0 = time.process_time()
     base, p, z = truth(kind, preset, hidden)
     try:
         if base == "fd_slow":
@@ -115,7 +117,7 @@ def make_trajectory(args):
     except Exception as e:  # noqa: BLE001 - reported as a generator failure of that case
         return path, 0.0, "generator failed: %s" % e
     os.replace(path + ".tmp.npz", path)
-    return path, time.time() - t0, ""
+    return path, time.process_time() - t0, ""
 
 
 def noisy_record(case, work):
@@ -124,7 +126,8 @@ def noisy_record(case, work):
     d = np.load(os.path.join(work, "traj_" + traj_key(case["kind"], case["preset"],
                                                       case["hidden"]) + ".npz"))
     rng = np.random.default_rng(case["seed"])
-    path = os.path.join(work, "rec_%s_%d.csv" % (case["kind"], case["seed"]))
+    path = os.path.join(work, "rec_%s_%d_%s.csv" % (case["kind"], case["id"],
+                                                     case.get("method", "explain")))
     if base == "fd_slow":
         records.write_slow(path, p["omega"], d["x"], noise.noisy_slow(d["q"], case["noise"],
                                                                        p["sigma"], rng))
@@ -140,14 +143,20 @@ def noisy_record(case, work):
 # ---------------------------------------------------------------- one run
 
 
+def child_cpu_s():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def run_tool(cmd, timeout=600):
-    t0 = time.time()
+    """(exit code, stderr, wall seconds, CPU seconds of the tool: user + system)."""
+    t0, c0 = time.time(), child_cpu_s()
     try:
         p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                            universal_newlines=True, timeout=timeout)
-        return p.returncode, p.stderr, time.time() - t0
+        return p.returncode, p.stderr, time.time() - t0, child_cpu_s() - c0
     except subprocess.TimeoutExpired:
-        return -1, "timeout after %d s" % timeout, time.time() - t0
+        return -1, "timeout after %d s" % timeout, time.time() - t0, child_cpu_s() - c0
 
 
 def verdict(case, selected, unexplained):
@@ -178,8 +187,9 @@ def run_case(job):
                case["method"], "--json", js]
     else:
         cmd = [tool, "explain", path, "--mode", mode, "--json", js]
-    rc, err, secs = run_tool(cmd)
+    rc, err, secs, cpu = run_tool(cmd)
     out["seconds"] = round(secs, 2)
+    out["cpu_s"] = round(cpu, 2)
     if rc != 0 or not os.path.exists(js):
         out.update(status="tool failed", why="exit %d: %s" % (rc, err.strip()[-300:]))
     else:
@@ -206,6 +216,11 @@ def run_case(job):
 
 
 # ---------------------------------------------------------------- the cases
+
+
+def stable(text):
+    """A platform-independent integer hash of a string (seeds, noise-model rotation)."""
+    return zlib.crc32(text.encode())
 
 
 def label(hidden, outside):
@@ -249,15 +264,17 @@ def explain_cases(kind, quick, terms=()):
             if not hidden and not outside:
                 reps = {"fd_raw": 5, "fd_slow": 3, "sweep": 4}[kind]  # more clean runs
             elif kind == "fd_slow" and len(hidden) == 2:
-                use = models[ci % 2::2]  # pairs: two of the four noise models, alternating
-            elif kind == "fd_raw" and len(hidden) == 2:  # pairs: one noise model, rotating
-                use = [models[(ci + pi) % len(models)]]
+                # pairs: two of the four noise models (white + AR 0.9 or AR 0.5 + gain drift),
+                # chosen by the pair's name so that a larger library keeps the old assignments
+                use = models[stable(label(hidden, None)) % 2::2]
+            elif kind == "fd_raw" and len(hidden) == 2:  # pairs: one of three noise models
+                use = [models[(stable(label(hidden, None)) + pi) % len(models)]]
             for m in use:
-                for _ in range(reps):
+                for rep in range(reps):
                     cases.append(dict(kind=kind, preset=preset, noise=m,
                                       hidden=hidden + ([outside] if outside else []),
                                       outside=outside, label=label(hidden, outside),
-                                      stand_in=outside_effects.get(outside)))
+                                      stand_in=outside_effects.get(outside), rep=rep))
     if quick:
         pick = {"fd_slow": [("fd_cyl_40s", "none", "white"), ("fd_mems_3s", "xi+kappa", "ar1_0.9")],
                 "sweep": [("sw_ring_24k", "none", "ar1_0.9"), ("sw_ring_11k", "gamma_nl+mu", "white")],
@@ -318,6 +335,7 @@ def summarize_explain(results):
                          lib_runs=len(lib), false_terms=ft, ft_ci=wilson(ft, len(lib)),
                          per=per, groups=groups, noises=noises,
                          seconds=sum(r.get("seconds", 0) for r in rs) / max(1, n),
+                         cpu_s=sum(r.get("cpu_s", 0) for r in rs) / max(1, n),
                          failing=[r for r in rs if not r.get("correct", False)])
     return out
 
@@ -368,17 +386,18 @@ def ci_txt(ci):
 def explain_tables(sx):
     L = ["| data kind | runs | correct | 95 % CI | target >= 95 % | clean runs | false alarms "
          "(any term or unexplained) | 95 % CI | target <= 5 % | false term, library runs | "
-         "tool failed | s/run |", "|---" * 12 + "|"]
+         "tool failed | s/run (wall) | CPU s/run |", "|---" * 13 + "|"]
     for kind in KINDS:
         if kind not in sx:
             continue
         s = sx[kind]
-        L.append("| %s | %d | %d (%s) | %s | %s | %d | %d (%s) | %s | %s | %d / %d | %d | %.1f |" % (
+        L.append("| %s | %d | %d (%s) | %s | %s | %d | %d (%s) | %s | %s | %d / %d | %d | %.1f | %.1f "
+                 "|" % (
             kind, s["runs"], s["correct"], pct(s["correct"] / s["runs"]), ci_txt(s["ci"]),
             "met" if s["correct"] / s["runs"] >= TARGET_CORRECT else "MISSED", s["clean_runs"],
             s["false_alarms"], pct(s["false_alarms"] / max(1, s["clean_runs"])), ci_txt(s["fa_ci"]),
             "met" if s["false_alarms"] <= TARGET_FALSE_ALARM * s["clean_runs"] else "MISSED",
-            s["false_terms"], s["lib_runs"], s["failed"], s["seconds"]))
+            s["false_terms"], s["lib_runs"], s["failed"], s["seconds"], s["cpu_s"]))
     L += ["", "By what was hidden (correct / runs):", "",
           "| data kind | clean | one effect | two effects | outside the library |",
           "|---|---|---|---|---|"]
@@ -440,6 +459,47 @@ def coverage_tables(sc):
     return L
 
 
+def case_key(r):
+    return (r["kind"], r["preset"], r["label"], r["noise"], r.get("rep", 0), r.get("method", ""))
+
+
+def compare_tables(old, new, old_note):
+    """Before/after: explain verdicts on the same records (same case, same seed) and coverage."""
+    before = {case_key(r): r for r in old}
+    L = ["Before: %s." % old_note, "",
+         "| data kind | runs in both | same verdict | correct before | correct after | "
+         "wrong -> right | right -> wrong | new cases (correct / runs) |", "|---" * 8 + "|"]
+    for kind in KINDS:
+        rs = [r for r in new if r["kind"] == kind and not kind.startswith("cov_")]
+        if not rs:
+            continue
+        both = [(before[case_key(r)], r) for r in rs if case_key(r) in before]
+        if not both and not rs:
+            continue
+        same = sum((sorted(a.get("selected", [])), a.get("unexplained"), a["status"]) ==
+                   (sorted(b.get("selected", [])), b.get("unexplained"), b["status"])
+                   for a, b in both)
+        cb = sum(bool(a.get("correct")) for a, _ in both)
+        ca = sum(bool(b.get("correct")) for _, b in both)
+        up = sum(not a.get("correct") and bool(b.get("correct")) for a, b in both)
+        down = sum(bool(a.get("correct")) and not b.get("correct") for a, b in both)
+        fresh = [r for r in rs if case_key(r) not in before]
+        L.append("| %s | %d | %d | %d | %d | %d | %d | %d / %d |" % (
+            kind, len(both), same, cb, ca, up, down, sum(bool(r.get("correct")) for r in fresh),
+            len(fresh)))
+    so = summarize_coverage([r for r in old if r["kind"].startswith("cov_")])
+    sn = summarize_coverage([r for r in new if r["kind"].startswith("cov_")])
+    if so and sn:
+        L += ["", "| coverage data | method | coverage before | after | SE/RMS min-max before | "
+              "after |", "|---" * 6 + "|"]
+        for key in sorted(set(so) & set(sn)):
+            a, b = so[key], sn[key]
+            L.append("| %s | %s | %.3f | %.3f | %.2f-%.2f | %.2f-%.2f |" % (
+                key[0], key[1], a["coverage"], b["coverage"], a["se_min"], a["se_max"],
+                b["se_min"], b["se_max"]))
+    return L
+
+
 def setup_text():
     L = ["Presets (own, not config/resonators):", ""]
     for name, p in list(presets.FREE_DECAY.items()) + list(presets.RAW.items()):
@@ -469,9 +529,13 @@ def main():
     ap.add_argument("--coverage-runs", type=int, default=60)
     ap.add_argument("--json", default="", help="all results as JSON")
     ap.add_argument("--markdown", default="", help="write the full report (tables) here")
-    ap.add_argument("--work", default="", help="keep records and tool output in this folder")
+    ap.add_argument("--work", default="", help="cache the clean trajectories in this folder")
+    ap.add_argument("--keep-records", action="store_true",
+                    help="keep the noisy records and the tool's JSON in the work folder")
     ap.add_argument("--explain-doc", default="",
                     help="replace the independent section of this file (docs/validation_explain.md)")
+    ap.add_argument("--compare", default="",
+                    help="an earlier run's --json: add before/after tables on the same records")
     ap.add_argument("--coverage-doc", default="",
                     help="replace the independent coverage section of this file (docs/validation.md)")
     args = ap.parse_args()
@@ -494,7 +558,10 @@ def main():
         else:
             cases += explain_cases(kind, args.quick, terms)
     for i, c in enumerate(cases):
-        c["seed"] = SEED0 + i
+        c["id"] = i
+    for c in cases:  # a case keeps its seed when other cases are added (before/after comparisons)
+        c["seed"] = SEED0 + stable(json.dumps([c["kind"], c["preset"], c["label"], c["noise"],
+                                               c["rep"]])) % 1000000
     if args.quick:  # the smoke subset: explain cases, plus at most 1 coverage pair
         cov = [c for c in cases if c["kind"].startswith("cov_")][:2]
         cases = [c for c in cases if not c["kind"].startswith("cov_")] + cov
@@ -512,8 +579,10 @@ def main():
     print("%d runs, %d clean trajectories to generate (work folder %s)" % (
         len(cases), len(trajs), work))
     errors = {}
+    args.gen_cpu = 0.0
     with multiprocessing.Pool(args.jobs) as pool:
         for key, (path, secs, err) in zip(trajs, pool.imap(make_trajectory, trajs.values())):
+            args.gen_cpu += secs
             if err:
                 errors[key] = err
                 print("  generator: %s %s: %s" % (trajs[key][0], trajs[key][1], err))
@@ -523,13 +592,14 @@ def main():
             if key in errors:
                 c["generator_error"] = errors[key]
         results = []
-        jobs = [(c, args.tool, work, bool(args.work)) for c in cases]
+        jobs = [(c, args.tool, work, args.keep_records) for c in cases]
         for i, r in enumerate(pool.imap_unordered(run_case, jobs)):
             results.append(r)
             if (i + 1) % 25 == 0 or i + 1 == len(jobs):
                 print("  %d / %d runs (%.0f s)" % (i + 1, len(jobs), time.time() - t_start),
                       flush=True)
-    results.sort(key=lambda r: r["seed"])
+    results.sort(key=lambda r: r["id"])
+    args.cpu_total = sum(r.get("cpu_s", 0.0) for r in results)
     ex = [r for r in results if not r["kind"].startswith("cov_")]
     cv = [r for r in results if r["kind"].startswith("cov_")]
     sx = summarize_explain(ex) if ex else {}
@@ -540,12 +610,23 @@ def main():
         lines += ["## Explain verdicts", ""] + explain_tables(sx)
     if sc:
         lines += ["", "## Interval coverage (identify)", "", COVERAGE_TEXT, ""] + coverage_tables(sc)
+    if args.compare and os.path.exists(args.compare):
+        with open(args.compare) as fh:
+            old = json.load(fh)
+        note = "%s (tool %s, library terms beyond ten: %s)" % (
+            old.get("measured", "earlier run"), old.get("tool", "?"),
+            ", ".join(old.get("library_terms_beyond_ten", [])) or "none")
+        lines += ["", "## Before / after (same records)", ""] + compare_tables(
+            old["results"], results, note)
     print("\n".join(lines))
-    print("total %.0f s, %d runs" % (elapsed, len(results)))
+    print("total %.0f s, %d runs; tool CPU %.0f s (%.1f min on %d cores)" % (
+        elapsed, len(results), args.cpu_total, args.cpu_total / 60.0 / args.jobs, args.jobs))
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(dict(results=results, elapsed_s=elapsed, quick=args.quick,
-                           selfcheck="ok", kinds=kinds, library_terms_beyond_ten=terms), fh,
+                           selfcheck="ok", kinds=kinds, library_terms_beyond_ten=terms,
+                           tool=tool_version(args.tool),
+                           measured=time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())), fh,
                       indent=1, default=str)
     if args.markdown:
         with open(args.markdown, "w") as fh:
@@ -649,7 +730,11 @@ def report_header(args, elapsed, n):
             "that it names: %s)." % (
                 time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), " --quick" if args.quick else "",
                 "" if args.kinds == ",".join(KINDS) else " --kinds " + args.kinds, n, elapsed,
-                args.jobs, tool_version(args.tool), ", ".join(args.terms) or "none"), ""] + setup_text() + [""]
+                args.jobs, tool_version(args.tool), ", ".join(args.terms) or "none"),
+            "", "Cost: the tool's CPU time (user + system, summed over runs) %.0f s, i.e. %.1f min "
+            "on %d unloaded cores; generator %.0f s (CPU, cached trajectories not counted). "
+            "Wall time depends on the machine's load." % (
+                args.cpu_total, args.cpu_total / 60.0 / args.jobs, args.jobs, args.gen_cpu), ""] + setup_text() + [""]
 
 
 if __name__ == "__main__":
