@@ -22,8 +22,8 @@ Scoring (fixed here, before any run):
   false alarm       clean record: any term selected or unexplained true
   coverage          fraction of (run, parameter) intervals containing the truth; SE ratio per
                     parameter = mean reported std / RMS error
-Rates carry Wilson 95 % intervals (scipy.stats.binomtest). Seeds from 50000 (the unit tests use
-< 10000; the old own-simulator validation 1000-1199).
+Rates carry Wilson 95 % intervals (scipy.stats.binomtest). Seeds from 50000 (50000 + a hash of
+the case; the unit tests use < 10000, the old own-simulator validation 1000-1199).
 
 Usage: validate_independent.py [--quick] [--kinds fd_slow,sweep,fd_raw,cov_fd_ar1,cov_sweep_ar1,
          cov_raw] [--jobs 2] [--tool bin/cvg_ident] [--json FILE] [--markdown FILE]
@@ -279,7 +279,8 @@ def explain_cases(kind, quick, terms=()):
         pick = {"fd_slow": [("fd_cyl_40s", "none", "white"), ("fd_mems_3s", "xi+kappa", "ar1_0.9")],
                 "sweep": [("sw_ring_24k", "none", "ar1_0.9"), ("sw_ring_11k", "gamma_nl+mu", "white")],
                 "fd_raw": [("raw_1k2", "none", "white")]}[kind]
-        cases = [next(c for c in cases if (c["preset"], c["label"], c["noise"]) == p) for p in pick]
+        cases = [next(c for c in sorted(cases, key=lambda c: c["noise"] != p[2])
+                      if (c["preset"], c["label"]) == p[:2]) for p in pick]
     # effect coefficients use the library names; outside effects are listed in hidden for the
     # generator and removed for scoring
     for c in cases:
@@ -534,6 +535,8 @@ def main():
                     help="keep the noisy records and the tool's JSON in the work folder")
     ap.add_argument("--explain-doc", default="",
                     help="replace the independent section of this file (docs/validation_explain.md)")
+    ap.add_argument("--from-json", default="",
+                    help="comma-separated --json files of earlier runs: report them as one run")
     ap.add_argument("--compare", default="",
                     help="an earlier run's --json: add before/after tables on the same records")
     ap.add_argument("--coverage-doc", default="",
@@ -543,11 +546,41 @@ def main():
     bad = [k for k in kinds if k not in KINDS]
     if bad:
         ap.error("unknown kinds %s (known: %s)" % (bad, ", ".join(KINDS)))
+    if args.from_json:
+        results, t_start, kinds, terms = load_runs(args)
+    else:
+        t_start = time.time()
+        results, terms = run_all(args, kinds)
+        if results is None:
+            return 2
+    report(args, kinds, terms, results, t_start)
+    return 0
+
+
+def load_runs(args):
+    """Results of earlier runs (their --json files, e.g. one per data kind) as one run."""
+    results, elapsed, kinds, terms, gen = [], 0.0, [], None, 0.0
+    for path in args.from_json.split(","):
+        with open(path) as fh:
+            d = json.load(fh)
+        results += d["results"]
+        elapsed += d["elapsed_s"]
+        kinds += [k for k in d["kinds"] if k not in kinds]
+        terms = d.get("library_terms_beyond_ten", []) if terms is None else terms
+        gen += d.get("gen_cpu_s", 0.0)
+    args.terms, args.gen_cpu = terms or [], gen
+    args.kinds = ",".join(k for k in KINDS if k in kinds)
+    args.quick = False
+    return results, time.time() - elapsed, kinds, args.terms
+
+
+def run_all(args, kinds):
+    """Generates the records, runs the tool on every case; (results, terms) or (None, None)."""
     t_start = time.time()
     print("generator self-check:")
     if not selfcheck.run(fast=True):
         print("validate_independent: the generator's self-check FAILED; no validation run")
-        return 2
+        return None, None
     cases = []
     terms = args.terms = tool_terms(args.tool)
     print("library terms beyond the original ten that the tool names: %s" % (
@@ -598,7 +631,14 @@ def main():
             if (i + 1) % 25 == 0 or i + 1 == len(jobs):
                 print("  %d / %d runs (%.0f s)" % (i + 1, len(jobs), time.time() - t_start),
                       flush=True)
-    results.sort(key=lambda r: r["id"])
+    if work_ctx:
+        work_ctx.cleanup()
+    return results, terms
+
+
+def report(args, kinds, terms, results, t_start):
+    """Prints the tables, writes the JSON, the full report and the doc sections."""
+    results.sort(key=lambda r: (KINDS.index(r["kind"]), r["id"]))
     args.cpu_total = sum(r.get("cpu_s", 0.0) for r in results)
     ex = [r for r in results if not r["kind"].startswith("cov_")]
     cv = [r for r in results if r["kind"].startswith("cov_")]
@@ -625,6 +665,7 @@ def main():
         with open(args.json, "w") as fh:
             json.dump(dict(results=results, elapsed_s=elapsed, quick=args.quick,
                            selfcheck="ok", kinds=kinds, library_terms_beyond_ten=terms,
+                           gen_cpu_s=args.gen_cpu,
                            tool=tool_version(args.tool),
                            measured=time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())), fh,
                       indent=1, default=str)
@@ -648,9 +689,6 @@ def main():
                 "## Coverage on independent records (scripts/validate_independent.py)", ""]
                 + head[2:3] + ["", COVERAGE_TEXT, ""] + coverage_tables(sc),
                 before="<!-- measured by scripts/validate_identification.py -->")
-    if work_ctx:
-        work_ctx.cleanup()
-    return 0
 
 
 COVERAGE_TEXT = ("One truth per row (%s), the noise redrawn per run (seeds from %d); "
@@ -719,16 +757,19 @@ pump have none). **False alarm** (clean records) = any term selected or `unexpla
 **False term** = a selected term that was not hidden (library runs). A run where the tool fails
 counts as wrong. Targets: correct >= 95 % per data kind; false alarms <= 5 % on clean records
 of every kind; interval coverage 0.90-0.98 and SE/RMS 0.8-1.25 for every parameter. Intervals
-are Wilson 95 % (scipy.stats.binomtest). Seeds 50000 + run index.
+are Wilson 95 % (scipy.stats.binomtest). Seeds 50000 + (CRC-32 of the case: kind, preset,
+hidden, noise, repeat) mod 10^6, so a case keeps its record when cases are added; the LS and
+Ceres coverage runs of one repeat share a record.
 """
 
 
 def report_header(args, elapsed, n):
     return [DOC_INTRO, "<!-- written by scripts/validate_independent.py -->",
-            "Measured %s, command `/usr/bin/python3 scripts/validate_independent.py%s%s` "
+            "Measured %s, command `/usr/bin/python3 scripts/validate_independent.py%s%s%s` "
             "(%d runs, %.0f s on %d worker processes; tool %s, library terms beyond the original ten "
             "that it names: %s)." % (
                 time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), " --quick" if args.quick else "",
+                " --coverage-runs %d" % args.coverage_runs if args.coverage_runs != 60 else "",
                 "" if args.kinds == ",".join(KINDS) else " --kinds " + args.kinds, n, elapsed,
                 args.jobs, tool_version(args.tool), ", ".join(args.terms) or "none"),
             "", "Cost: the tool's CPU time (user + system, summed over runs) %.0f s, i.e. %.1f min "
