@@ -38,6 +38,7 @@ const char* kHelp =
     "  --topic  bag topic to read (default: the one topic of a project message type)\n"
     "  --model  linear, or +-joined extensions: xi, kappa, gamma_nl, cm_rate (free decay), "
     "xi_diff,\n"
+    "           xi_k (second cubic invariant: precession proportional to r k),\n"
     "           mu (forced, needs --method ceres: mu multiplies u~ bilinearly).\n"
     "  --method ls (batch QR, default), rls (block recursive LS (2.12)), ceres (output-error fit\n"
     "           started from LS; removes the errors-in-variables bias of noisy forced sweeps).\n"

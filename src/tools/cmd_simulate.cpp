@@ -31,7 +31,7 @@ const char* kHelp =
     "                    segment per settled step with columns omega0 and drive_phase_rad\n"
     "  --seed N          seed of the Gaussian measurement noise (default 1)\n"
     "  --effect N=V      set a true parameter (repeatable): gamma nu b_c b_s c_m n h_c h_s xi\n"
-    "                    kappa gamma_nl cm_rate xi_diff (model terms), u1..u4 (drive u~), mu\n"
+    "                    kappa gamma_nl cm_rate xi_diff xi_k (model terms), u1..u4 (drive u~), mu\n"
     "                    (control nonlinearity), eta (2 omega0 parametric terms of (2.1), raw\n"
     "                    forced only; 0 = off)\n"
     "  --noise STD       noise std overriding the preset's (q, or f, g with --raw); 0 = none\n"

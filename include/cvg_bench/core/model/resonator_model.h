@@ -5,7 +5,7 @@
 // Parameter vector z (regression units, in parameterNames() order):
 //   linear base  gamma, nu, b_c, b_s [1/s]; c_m, n, h_c, h_s [1/s, tilde = coefficient / omega];
 //   forced mode  u1..u4 [1/s x amplitude, tilde = eta u_i / omega];
-//   extensions   xi, kappa, xi_diff [tilde, 1/(s amplitude^2), 1/(s amplitude^4)], gamma_nl
+//   extensions   xi, kappa, xi_diff, xi_k [tilde, 1/(s amplitude^2), 1/(s amplitude^4)], gamma_nl
 //                [1/(s amplitude^2)], cm_rate [1/s^2, tilde].
 // Amplitudes are in the record's units (normalized by the maximum amplitude in the paper's section
 // 4).
@@ -24,7 +24,8 @@ namespace cvg_bench {
 using ParameterValues = std::map<std::string, double>;
 
 /// Detuning rate of the forced averaged equations: exactly (omega0^2 - omega^2) / omega0
-/// = 2 lambda - lambda^2 / (omega + lambda) with lambda = omega0 - omega (docs/paper.md item 7) [rad/s].
+/// = 2 lambda - lambda^2 / (omega + lambda) with lambda = omega0 - omega (docs/paper.md item 7)
+/// [rad/s].
 double detuningRate(double omega_rad_s, double omega0_rad_s);
 
 /// The vector multiplying the detuning rate in (3.2)-(3.3): y / (2 lambda) = (p1, -q1, p2, -q2).
