@@ -122,8 +122,7 @@ void printTable(const Estimate& e, std::ostream& os) {
   }
   if (!e.interval_method_id.empty())
     os << "intervals: " << e.interval_method_id << "; residual lag-1 correlation "
-       << e.residual_lag1 << " (z = " << e.residual_lag1_z << "), noise " << e.noise_model
-       << "\n";
+       << e.residual_lag1 << " (z = " << e.residual_lag1_z << "), noise " << e.noise_model << "\n";
   if (!e.identifiability_note.empty()) os << "identifiability: " << e.identifiability_note << "\n";
   for (const auto& n : e.notes) os << "note: " << n << "\n";
 }

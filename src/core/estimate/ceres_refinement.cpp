@@ -281,9 +281,8 @@ CeresCovariance outputErrorCovariance(const FittedProblem& fp, const AtSolution&
   out.cov = sigma2_sample * unscaled * s_mat * unscaled;
   out.cov = 0.5 * (out.cov + out.cov.transpose());
   out.id = "demod_correlation";
-  e->noise_model = "stated by the record (demodulator): rho_1 = " +
-                   fmt3(fp.noise_correlation[0]) + ", " +
-                   std::to_string(fp.noise_correlation.size()) + " lag(s)";
+  e->noise_model = "stated by the record (demodulator): rho_1 = " + fmt3(fp.noise_correlation[0]) +
+                   ", " + std::to_string(fp.noise_correlation.size()) + " lag(s)";
   out.method =
       "output error (Ceres): sigma^2 C J' Sigma J C, C = (J'J)^+ by ceres::Covariance "
       "DENSE_SVD, Sigma the demodulator's noise correlation (rho_1 = " +
@@ -303,8 +302,8 @@ void fillIdentifiability(const FittedProblem& fp, const AtSolution& a, const Ran
   if (r.rank == p) {
     // S V' diag(norms) has the Gram J'J: the SVD already taken, without the n rows again.
     const Eigen::MatrixXd factor = r.s.asDiagonal() * r.v.transpose() * r.norms.asDiagonal();
-    reportCollinearity(analyzeCollinearity(fp.all_names, factor, fp.n_reported), fp.all_names,
-                       a.x, cov, summarizeExcitation(*fp.q), s_p, e);
+    reportCollinearity(analyzeCollinearity(fp.all_names, factor, fp.n_reported), fp.all_names, a.x,
+                       cov, summarizeExcitation(*fp.q), s_p, e);
     return;
   }
   Eigen::MatrixXd null_space = r.norms.cwiseInverse().asDiagonal() * r.v.rightCols(p - r.rank);
@@ -355,10 +354,9 @@ void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estima
   e->singular_values.assign(r.s.data(), r.s.data() + r.s.size());
   e->rank_tolerance = options.rank_tolerance;
   fillIdentifiability(fp, a, r, cc.cov, s_p, e);
-  if (options.derive_quantities)
-    deriveFromIdentified(e, e->omega_rad_s, options.angular_gain_k);
-  else
-    e->derived.clear();
+  e->derived.clear();
+  e->derived_method.clear();
+  if (options.derive_quantities) deriveFromIdentified(e, e->omega_rad_s, options.angular_gain_k);
 }
 
 void checkTimes(const SlowRecord& record) {

@@ -32,7 +32,9 @@ std::string NoiseCorrelation::describe() const {
 }
 
 CorrelatedSensitivityGram::CorrelatedSensitivityGram(int k, NoiseCorrelation rho)
-    : k_(k), rho_(std::move(rho)), s_(Eigen::MatrixXd::Zero(k, k)),
+    : k_(k),
+      rho_(std::move(rho)),
+      s_(Eigen::MatrixXd::Zero(k, k)),
       filtered_(Eigen::MatrixXd::Zero(4, k)) {
   if (rho_.ar1 == 0.0) ring_.assign(rho_.lags.size(), Eigen::MatrixXd::Zero(4, k));
 }
@@ -53,7 +55,8 @@ void CorrelatedSensitivityGram::add(const RegressionBlockMatrix& w_t, bool first
   } else if (!ring_.empty()) {
     const long lmax = static_cast<long>(ring_.size());
     for (long l = 1; l <= std::min(in_record_, lmax); ++l) {
-      const Eigen::MatrixXd cross = rho_.lags[l - 1] * (w.transpose() * ring_[(in_record_ - l) % lmax]);
+      const Eigen::MatrixXd cross =
+          rho_.lags[l - 1] * (w.transpose() * ring_[(in_record_ - l) % lmax]);
       s_ += cross + cross.transpose();
     }
     ring_[in_record_ % lmax] = w;
@@ -61,6 +64,8 @@ void CorrelatedSensitivityGram::add(const RegressionBlockMatrix& w_t, bool first
   ++in_record_;
 }
 
-Eigen::MatrixXd CorrelatedSensitivityGram::sum() const { return s_; }
+Eigen::MatrixXd CorrelatedSensitivityGram::sum() const {
+  return s_;
+}
 
 }  // namespace cvg_bench

@@ -110,8 +110,8 @@ void deriveFromIdentified(Estimate* e, double omega_rad_s, double angular_gain_k
   const bool full_rank = e->rank >= e->n_params;
   if (full_rank) {
     try {
-      e->derived = deriveQuantitiesWithIntervals(uncertainParameters(*e), omega_rad_s,
-                                                 angular_gain_k);
+      e->derived =
+          deriveQuantitiesWithIntervals(uncertainParameters(*e), omega_rad_s, angular_gain_k);
     } catch (const InputError& err) {
       e->notes.push_back(std::string("derived quantities not computed: ") + err.what());
     }
@@ -131,7 +131,8 @@ void deriveFromIdentified(Estimate* e, double omega_rad_s, double angular_gain_k
     if (gamma_unknown) {
       e->derived["Q"] = q_env;
       e->derived_method["Q"] =
-          "Q " + how + "; the split of the damping between gamma and the anisotropy b is not "
+          "Q " + how +
+          "; the split of the damping between gamma and the anisotropy b is not "
           "identified by this record, so omega/gamma is not reported";
     } else if (e->derived.count("Q")) {
       e->derived_method["Q"] = "omega/gamma";

@@ -164,8 +164,7 @@ HacCovariance hacCovarianceBlocked(const Eigen::MatrixXd& jacobian,
 HacCovariance hacCovarianceFromScores(const Eigen::MatrixXd& scores, const Eigen::MatrixXd& r_pinv,
                                       long n_rows, int rank, int lag) {
   const long nb = scores.rows();
-  if (nb < 3 || scores.cols() != r_pinv.rows() || r_pinv.rows() != r_pinv.cols() ||
-      n_rows <= rank)
+  if (nb < 3 || scores.cols() != r_pinv.rows() || r_pinv.rows() != r_pinv.cols() || n_rows <= rank)
     throw InputError("HAC covariance: " + std::to_string(nb) + " score rows of " +
                      std::to_string(scores.cols()) + " for a " + std::to_string(r_pinv.rows()) +
                      "-parameter factor and " + std::to_string(n_rows) + " rows");

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/collinearity.h"
 #include "cvg_bench/core/estimate/correlated_noise_gram.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
@@ -18,7 +19,6 @@
 #include "cvg_bench/core/estimate/recursive_least_squares.h"
 #include "cvg_bench/core/estimate/residual_correlation.h"
 #include "cvg_bench/core/estimate/student_t.h"
-#include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
@@ -252,14 +252,12 @@ HonestCovariance freeDecayCovariance(const BlockStream& stream, const SystemInfo
     // of A are O(h ||G||) and left out).
     FreeDecayNoisePropagation again(*info.resonator, z);
     CorrelatedSensitivityGram gram(k, rho);
-    again.setSampleSink(
-        [&](const RegressionBlockMatrix& w, bool first) { gram.add(w, first); });
+    again.setSampleSink([&](const RegressionBlockMatrix& w, bool first) { gram.add(w, first); });
     stream([&](int, const RegressionBlock& b) { again.add(b); });
     meat = gram.sum();
     gain -= 32.0 * rho.at(2) * static_cast<double>(blocks);
   }
-  const double sigma_q2 =
-      gain > 0.0 ? h.rss / gain * static_cast<double>(s.n) / dof_paper : 0.0;
+  const double sigma_q2 = gain > 0.0 ? h.rss / gain * static_cast<double>(s.n) / dof_paper : 0.0;
   h.covariance = sigma_q2 * c * meat * c;
   e->interval_method =
       "errors-in-variables covariance of the differenced regression: sigma_q^2 C (sum_m,m' "
@@ -379,9 +377,9 @@ void fillIntervals(const SolvedSystem& s, HonestCovariance h, const SystemInfo& 
     e->unidentifiable = idr.unidentifiable;
     e->identifiability_note = idr.note;
     for (const auto& comb : idr.combinations)
-      e->combinations[comb.name] = interval(comb.coefficients.dot(e->values),
-                                            comb.coefficients.dot(e->covariance * comb.coefficients),
-                                            sp_honest);
+      e->combinations[comb.name] =
+          interval(comb.coefficients.dot(e->values),
+                   comb.coefficients.dot(e->covariance * comb.coefficients), sp_honest);
   } else {
     reportCollinearity(analyzeCollinearity(info.names, s.r, k), info.names, e->values,
                        e->covariance, s.excitation, sp_honest, e);

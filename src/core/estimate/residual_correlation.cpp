@@ -23,8 +23,7 @@ std::vector<double> ResidualLagAccumulator::correlations() const {
   return c;
 }
 
-SerialCorrelationTest testLagOne(double lag1, double expected, double variance_factor,
-                                 long steps) {
+SerialCorrelationTest testLagOne(double lag1, double expected, double variance_factor, long steps) {
   SerialCorrelationTest t;
   t.lag1 = lag1;
   t.expected = expected;
@@ -59,7 +58,10 @@ double fitDifferencedAr1(const std::vector<double>& c) {
   const double g = (std::sqrt(5.0) - 1.0) / 2.0;
   for (int it = 0; it < 40; ++it) {
     const double x1 = b - g * (b - a), x2 = a + g * (b - a);
-    if (misfit(x1) < misfit(x2)) b = x2; else a = x1;
+    if (misfit(x1) < misfit(x2))
+      b = x2;
+    else
+      a = x1;
   }
   return 0.5 * (a + b);
 }

@@ -1,6 +1,6 @@
 // Near-collinear identifiability (collinearity.h): exact variance-inflation factors on a known
-// design; a free decay with one standing wave along an axis (the second mode only noise) reports the
-// individual damping / frequency parameters as not identified, names the combinations it
+// design; a free decay with one standing wave along an axis (the second mode only noise) reports
+// the individual damping / frequency parameters as not identified, names the combinations it
 // determines, and takes Q from the envelope decay, whose interval holds the trajectory's true
 // envelope Q; two pattern angles identify everything and Q comes from gamma.
 #include "cvg_bench/core/estimate/collinearity.h"
@@ -25,15 +25,27 @@ constexpr double kOmega = 1000.0;
 
 SlowRecord run(double theta, double sigma, unsigned seed) {
   const ResonatorModel model("linear", ExperimentMode::kFreeDecay);
-  SlowRecord r = testing_support::simulateFreeDecay(model, model.parameterVector(kTruth),
-                                                    slowFromOrbit({1.0, 0.0, theta, 0.0}), 0.02,
-                                                    2000);
+  SlowRecord r = testing_support::simulateFreeDecay(
+      model, model.parameterVector(kTruth), slowFromOrbit({1.0, 0.0, theta, 0.0}), 0.02, 2000);
   r.omega_rad_s = kOmega;
   return sigma > 0 ? testing_support::withNoise(r, sigma, seed) : r;
 }
 
 bool has(const std::vector<std::string>& v, const std::string& x) {
   return std::find(v.begin(), v.end(), x) != v.end();
+}
+
+/// The reported combination of gamma and b_c ("gamma+b_c", or with a coefficient near 1 when the
+/// noise tilts the weak direction), or nullptr.
+const ParameterEstimate* gammaPlusBc(const Estimate& e, std::string* name) {
+  for (const auto& kv : e.combinations) {
+    if (kv.first.rfind("gamma+", 0) == 0 && kv.first.find("b_c") != std::string::npos &&
+        kv.first.find("nu") == std::string::npos) {
+      *name = kv.first;
+      return &kv.second;
+    }
+  }
+  return nullptr;
 }
 
 TEST(Collinearity, VarianceInflationOfTwoCorrelatedColumnsIsOneOverOneMinusRSquared) {
@@ -63,9 +75,10 @@ TEST(Collinearity, StandingWaveAlongAnAxisReportsNotIdentifiedAndQFromTheEnvelop
     for (const char* p : {"gamma", "b_c", "nu", "b_s"}) EXPECT_TRUE(has(e.not_identified, p)) << p;
     EXPECT_GT(e.vif.at("gamma"), 1e4);
     EXPECT_FALSE(e.weak_directions.empty());
-    ASSERT_TRUE(e.combinations.count("gamma+b_c")) << e.identifiability_note;
-    const ParameterEstimate& g = e.combinations.at("gamma+b_c");
-    EXPECT_LT(std::fabs(g.value - 0.06), 5 * g.std_error + 1e-12);
+    std::string name;
+    const ParameterEstimate* g = gammaPlusBc(e, &name);
+    ASSERT_NE(g, nullptr) << e.identifiability_note;
+    EXPECT_LT(std::fabs(g->value - 0.06), 5 * g->std_error + 1e-4) << name;
     EXPECT_NE(e.identifiability_note.find("not identified by this record"), std::string::npos);
     ASSERT_TRUE(e.derived.count("Q"));
     EXPECT_NE(e.derived_method.at("Q").find("envelope"), std::string::npos);
@@ -91,7 +104,8 @@ TEST(Collinearity, OutputErrorFitReportsTheSameWeakParameters) {
   const Estimate start = identifyFreeDecay(rec, IdentificationOptions());
   const Estimate e = refineWithCeres(rec, start);
   for (const char* p : {"gamma", "b_c"}) EXPECT_TRUE(has(e.not_identified, p)) << p;
-  ASSERT_TRUE(e.combinations.count("gamma+b_c")) << e.identifiability_note;
+  std::string name;
+  EXPECT_NE(gammaPlusBc(e, &name), nullptr) << e.identifiability_note;
   EXPECT_NE(e.derived_method.at("Q").find("envelope"), std::string::npos);
 }
 

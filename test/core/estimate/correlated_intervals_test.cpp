@@ -68,8 +68,7 @@ TEST(CorrelatedSensitivityGram, EqualsTheBruteForceDoubleSum) {
     Eigen::MatrixXd ref = Eigen::MatrixXd::Zero(k, k);
     for (int a = 0; a < n; ++a)
       for (int b = 0; b < n; ++b)
-        if ((a < 25) == (b < 25))
-          ref += rho.at(std::abs(a - b)) * ws[a].transpose() * ws[b];
+        if ((a < 25) == (b < 25)) ref += rho.at(std::abs(a - b)) * ws[a].transpose() * ws[b];
     EXPECT_LT((gram.sum() - ref).norm(), 1e-12 * ref.norm()) << rho.describe();
   }
 }
@@ -97,8 +96,8 @@ struct MonteCarlo {
 // Linear model, one record at pattern angle pi/8 with a little ellipticity, AR(1) rho = 0.9 on
 // each slow variable (sigma 2e-3 of an amplitude 1): the lag-1 test must switch to the AR(1) noise
 // model and the intervals must hold 95 %.
-const ParameterValues kTruth = {{"gamma", 0.05}, {"nu", 0.02},  {"b_c", 0.01}, {"b_s", -0.008},
-                                {"c_m", 0.3},    {"n", 0.03},   {"h_c", 0.1},  {"h_s", -0.05}};
+const ParameterValues kTruth = {{"gamma", 0.05}, {"nu", 0.02}, {"b_c", 0.01}, {"b_s", -0.008},
+                                {"c_m", 0.3},    {"n", 0.03},  {"h_c", 0.1},  {"h_s", -0.05}};
 
 SlowRecord linearRecord() {
   const ResonatorModel model("linear", ExperimentMode::kFreeDecay);
@@ -128,8 +127,8 @@ TEST(CorrelatedIntervals, WhiteNoiseKeepsTheWhiteModel) {
   const SlowRecord clean = linearRecord();
   int white = 0;
   for (unsigned seed = 7200; seed < 7220; ++seed) {
-    const Estimate e = identifyFreeDecay(testing_support::withNoise(clean, 2e-3, seed),
-                                         IdentificationOptions());
+    const Estimate e =
+        identifyFreeDecay(testing_support::withNoise(clean, 2e-3, seed), IdentificationOptions());
     white += e.interval_method_id == "eiv_white";
   }
   EXPECT_GE(white, 18);  // 1 % false-alarm test: P(>= 3 of 20) < 0.001

@@ -27,8 +27,8 @@ struct WeakDirection {
 };
 
 struct CollinearityReport {
-  std::vector<double> vif;       ///< per column of J
-  double condition_number = 1.0; ///< s_max / s_min of J_s (infinite when rank-deficient)
+  std::vector<double> vif;        ///< per column of J
+  double condition_number = 1.0;  ///< s_max / s_min of J_s (infinite when rank-deficient)
   std::vector<WeakDirection> weak;
   /// Among the first n_reported names: VIF >= kNotIdentifiedVif.
   std::vector<std::string> not_identified;

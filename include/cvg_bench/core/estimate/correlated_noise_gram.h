@@ -35,8 +35,8 @@ class CorrelatedSensitivityGram {
   int k_;
   NoiseCorrelation rho_;
   Eigen::MatrixXd s_;
-  Eigen::MatrixXd filtered_;            // AR(1): F_m = W_m' + rho F_{m-1} (4 x k)
-  std::vector<Eigen::MatrixXd> ring_;   // finite lags: the last L W_m'
+  Eigen::MatrixXd filtered_;           // AR(1): F_m = W_m' + rho F_{m-1} (4 x k)
+  std::vector<Eigen::MatrixXd> ring_;  // finite lags: the last L W_m'
   long in_record_ = 0;
 };
 

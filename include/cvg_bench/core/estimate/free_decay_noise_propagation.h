@@ -1,6 +1,6 @@
-// The honest covariance of the free-decay regression (2.7)-(2.8) (docs/paper.md item 10): neighbouring
-// equations share samples, and the noisy samples enter both y and D-bar. Linearized in white sample
-// noise eps_m (covariance sigma_q^2 I), the equation errors are
+// The honest covariance of the free-decay regression (2.7)-(2.8) (docs/paper.md item 10):
+// neighbouring equations share samples, and the noisy samples enter both y and D-bar. Linearized in
+// white sample noise eps_m (covariance sigma_q^2 I), the equation errors are
 //   e_i = sum_m A_im eps_m,  A_i,i+1 = 2 I - w_i,i+1 G_i+1,  A_i,i = -w_ii G_i,
 //   A_i,i-1 = -2 I - w_i,i-1 G_i-1,  G = d(D(q) z)/dq (ResonatorModel::regressorJacobian),
 // w the quadrature weights of D-bar_i, so D' Omega D = sigma_q^2 sum_m W_m W_m' with
@@ -13,8 +13,8 @@
 #include <Eigen/Core>
 #include <functional>
 
-#include "cvg_bench/core/estimate/internal/block_gram_accumulator.h"
 #include "cvg_bench/core/estimate/free_decay_regression.h"
+#include "cvg_bench/core/estimate/internal/block_gram_accumulator.h"
 
 namespace cvg_bench {
 
