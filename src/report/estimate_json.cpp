@@ -14,6 +14,36 @@ nlohmann::json parameterToJson(const ParameterEstimate& p) {
   return {{"value", p.value}, {"std", p.std_error}, {"ci_low", p.ci_low}, {"ci_high", p.ci_high}};
 }
 
+/// Which method made the intervals, the residuals' serial correlation, near-collinearity.
+void addIntervalDiagnostics(const Estimate& e, nlohmann::json* out) {
+  nlohmann::json& j = *out;
+  if (!e.interval_method_id.empty()) {
+    j["interval_method_id"] = e.interval_method_id;
+    j["residual_correlation"] = {{"lag1", e.residual_lag1},
+                                 {"lag1_expected_independent", e.residual_lag1_expected},
+                                 {"z", e.residual_lag1_z},
+                                 {"correlated", e.residual_correlated},
+                                 {"noise_model", e.noise_model}};
+  }
+  if (!e.vif.empty()) {
+    nlohmann::json weak = nlohmann::json::array();
+    for (const auto& w : e.weak_directions)
+      weak.push_back({{"direction_column_normalized", w.first}, {"singular_value", w.second}});
+    j["identifiability"] = {{"condition_number", e.condition_number},
+                            {"vif", e.vif},
+                            {"weak_directions", weak},
+                            {"not_identified", e.not_identified}};
+  }
+  j["not_identified"] = e.not_identified;
+  for (const auto& name : e.not_identified) {
+    if (!j["parameters"].contains(name)) continue;
+    j["parameters"][name]["identified"] = false;
+    j["parameters"][name]["note"] =
+        "not identified by this record (see identifiable_combinations and identifiability)";
+  }
+  if (!e.derived_method.empty()) j["derived_method"] = e.derived_method;
+}
+
 }  // namespace
 
 nlohmann::json estimateToJson(const Estimate& e) {
@@ -66,6 +96,7 @@ nlohmann::json estimateToJson(const Estimate& e) {
     j["identifiable_combinations"] = comb;
   }
   if (!e.singular_values.empty()) j["singular_values"] = e.singular_values;
+  addIntervalDiagnostics(e, &j);
   j["notes"] = e.notes;
   return j;
 }

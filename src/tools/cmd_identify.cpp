@@ -2,6 +2,7 @@
 // the integral regression (2.7)-(2.8); forced sweep: the stationary regression (3.4)-(3.5); LS
 // (batch QR), RLS (2.12, corrected pairing) or Ceres (output-error refinement of the LS answer).
 // Raw t,f,g input is demodulated first (free decay) and the output says so.
+#include <algorithm>
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
@@ -91,8 +92,13 @@ void printTable(const Estimate& e, std::ostream& os) {
   os << "  parameter        value          +- honest CI      +- paper (2.11)\n";
   for (const auto& name : e.names) {
     const auto it = e.parameters.find(name);
+    const bool weak =
+        std::find(e.not_identified.begin(), e.not_identified.end(), name) != e.not_identified.end();
     if (it == e.parameters.end()) {
       std::snprintf(buf, sizeof(buf), "  %-10s  (not identifiable alone)\n", name.c_str());
+    } else if (weak) {
+      std::snprintf(buf, sizeof(buf), "  %-10s  not identified by this record (VIF %.3g)\n",
+                    name.c_str(), e.vif.at(name));
     } else {
       const auto pp = e.parameters_paper.find(name);
       const double paper =
@@ -109,10 +115,15 @@ void printTable(const Estimate& e, std::ostream& os) {
   }
   if (!e.derived.empty()) os << "derived (section 4):\n";
   for (const auto& kv : e.derived) {
-    std::snprintf(buf, sizeof(buf), "  %-24s  %14.8g  +- %-14.6g\n", kv.first.c_str(),
-                  kv.second.value, kv.second.ci_high - kv.second.value);
+    std::snprintf(buf, sizeof(buf), "  %-24s  %14.8g  [%.6g, %.6g]\n", kv.first.c_str(),
+                  kv.second.value, kv.second.ci_low, kv.second.ci_high);
     os << buf;
+    const auto how = e.derived_method.find(kv.first);
+    if (how != e.derived_method.end()) os << "      (" << how->second << ")\n";
   }
+  if (!e.interval_method_id.empty())
+    os << "intervals: " << e.interval_method_id << "; residual lag-1 correlation "
+       << e.residual_lag1 << " (z = " << e.residual_lag1_z << "), noise " << e.noise_model << "\n";
   if (!e.identifiability_note.empty()) os << "identifiability: " << e.identifiability_note << "\n";
   for (const auto& n : e.notes) os << "note: " << n << "\n";
 }

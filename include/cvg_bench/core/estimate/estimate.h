@@ -57,6 +57,29 @@ struct Estimate {
   /// Singular values of the column-equilibrated regression matrix, descending.
   std::vector<double> singular_values;
   double rank_tolerance = 0.0;  ///< relative singular-value tolerance used for `rank`
+
+  // ---- serial correlation of the residuals and the method of the intervals
+  /// Short name of the method behind `parameters`: "eiv_white", "eiv_ar1", "demod_correlation",
+  /// "cluster_sandwich", "hac_bartlett_andrews", "iid", "paper_2_11" (empty: not set).
+  std::string interval_method_id;
+  double residual_lag1 = 0.0;           ///< lag-1 correlation of the residuals (one time step)
+  double residual_lag1_expected = 0.0;  ///< its value under independent noise
+  double residual_lag1_z = 0.0;         ///< the test statistic (residual_correlation.h)
+  bool residual_correlated = false;     ///< |z| > 2.576: the intervals account for it
+  std::string noise_model;              ///< e.g. "AR(1) rho = 0.9 (fitted)"
+
+  // ---- near-collinear identifiability (collinearity.h)
+  std::map<std::string, double> vif;  ///< variance-inflation factor per parameter
+  double condition_number = 0.0;      ///< of the column-normalized Jacobian (0: not computed)
+  /// Weakly identified directions: text (column-normalized coefficients) and singular value.
+  std::vector<std::pair<std::string, double>> weak_directions;
+  /// Parameters the record does not identify (VIF >= 1e4), reported with `combinations`.
+  std::vector<std::string> not_identified;
+  /// How a derived quantity was obtained where it is not the plain section-4 formula.
+  std::map<std::string, std::string> derived_method;
+  /// Free decay: c with c'z = the envelope decay rate gamma_env of the record (Q = omega /
+  /// gamma_env), in `names` order; empty otherwise.
+  Eigen::VectorXd envelope_coefficients;
 };
 
 }  // namespace cvg_bench
