@@ -30,7 +30,8 @@ const char* kHelp =
     "angles on [0, pi/2). Also prints section 4's derived quantities (angular gain K, default "
     "0.4).\n"
     "When the params file carries a covariance (identify --json), every figure gets a confidence\n"
-    "interval by the delta method (numerical Jacobian; the file's confidence and interval_dof).\n";
+    "interval by the delta method (numerical Jacobian; the file's confidence and interval_dof).\n"
+    "example: cvg_ident drift --params est.json --r 0.5 --k 0.1 --theta 0.3\n";
 
 }  // namespace
 
@@ -52,9 +53,7 @@ int runDrift(const std::vector<std::string>& argv) {
   if (args.has("theta")) {
     thetas.push_back(args.getDouble("theta", 0.0));
   } else {
-    const long n = args.getInt("theta-grid", 8);
-    if (n < 1 || n > 100000) throw InputError("--theta-grid needs 1..100000 points");
-    for (long i = 0; i < n; ++i) thetas.push_back(M_PI / 2 * i / n);
+    thetas = thetaGrid(args.getInt("theta-grid", 8));
   }
   UncertainParameters up;
   up.values = pf.values;

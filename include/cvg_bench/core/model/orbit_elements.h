@@ -1,7 +1,7 @@
 // Orbit elements of section 5: r (main wave amplitude), k (quadrature amplitude), theta (wave
 // pattern angle) and chi (temporal phase), by the change of variables (5.2), and their averaged
-// evolution (5.7)-(5.10) with the corrections of docs/paper.md item 4-5: the nonlinear terms carry the
-// tilde coefficients, and the damping-anisotropy terms depend on (theta - beta).
+// evolution (5.7)-(5.10) with the corrections of docs/paper.md item 4-5: the nonlinear terms carry
+// the tilde coefficients, and the damping-anisotropy terms depend on (theta - beta).
 #pragma once
 
 #include <Eigen/Core>
@@ -46,5 +46,11 @@ OrbitRates orbitRates(const OrbitElements& e, const ParameterValues& p);
 
 /// The drift rate theta' of (5.9) [rad/s] (corrected), the gyro's zero-rate error at (r, k, theta).
 double driftRate(double r, double k, double theta, const ParameterValues& p);
+
+/// Most points a pattern-angle grid may have.
+constexpr long kMaxThetaGridPoints = 100000;
+/// n pattern angles theta_i = (pi / 2) i / n, i = 0..n-1, evenly over one period [0, pi/2) of the
+/// drift (5.9) in theta. InputError unless 1 <= n <= kMaxThetaGridPoints.
+std::vector<double> thetaGrid(long n);
 
 }  // namespace cvg_bench
