@@ -9,10 +9,10 @@
 #include "bag_input.h"
 #include "cli_args.h"
 #include "cvg_bench/core/demod/demodulator.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/demod/frequency_estimator.h"
 #include "cvg_bench/core/demod/irregular_demodulator.h"
 #include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_ident_commands.h"
 
 namespace cvg_bench {
@@ -37,7 +37,8 @@ const char* kHelp =
     "  --window S     least-squares window for irregular timestamps [s] (default 2 / rate).\n"
     "Uniform timestamps (every interval within 1 % of the median, or a whole multiple of it for\n"
     "dropped samples) use the FIR path (passband 0.2 x rate, stopband 0.5 x rate); otherwise the\n"
-    "windowed least-squares path is used. The choice is printed on stderr and in the output.\n";
+    "windowed least-squares path is used. The choice is printed on stderr and in the output.\n"
+    "example: cvg_ident demod raw.csv --rate 200 --out slow_200hz.csv\n";
 
 }  // namespace
 

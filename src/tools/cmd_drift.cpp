@@ -32,7 +32,8 @@ const char* kHelp =
     "When the params file carries a covariance (identify --json), every figure gets a confidence\n"
     "interval by the delta method (numerical Jacobian; the file's confidence and interval_dof).\n"
     "At one state (--r --k --theta) it also prints the amplitude envelope's decay rate\n"
-    "-2 r'/r of (5.7) and the Q = omega / rate it implies (JSON \"envelope\").\n";
+    "-2 r'/r of (5.7) and the Q = omega / rate it implies (JSON \"envelope\").\n"
+    "example: cvg_ident drift --params est.json --r 0.5 --k 0.1 --theta 0.3\n";
 
 /// The amplitude envelope's decay at one state, from (5.7): rate = -2 r'/r [1/s] and the quality
 /// factor Q = omega / rate that a ring-down at this state shows, with the rate's CI (delta method)
@@ -83,9 +84,7 @@ int runDrift(const std::vector<std::string>& argv) {
   if (args.has("theta")) {
     thetas.push_back(args.getDouble("theta", 0.0));
   } else {
-    const long n = args.getInt("theta-grid", 8);
-    if (n < 1 || n > 100000) throw InputError("--theta-grid needs 1..100000 points");
-    for (long i = 0; i < n; ++i) thetas.push_back(M_PI / 2 * i / n);
+    thetas = thetaGrid(args.getInt("theta-grid", 8));
   }
   UncertainParameters up;
   up.values = pf.values;

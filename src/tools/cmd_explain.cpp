@@ -8,11 +8,11 @@
 #include "bag_input.h"
 #include "cli_args.h"
 #include "cvg_bench/core/demod/demodulator.h"
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/diagnose/explanation.h"
 #include "cvg_bench/core/demod/frequency_estimator.h"
 #include "cvg_bench/core/demod/irregular_demodulator.h"
+#include "cvg_bench/core/diagnose/explanation.h"
 #include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_bench/report/explain_json.h"
 #include "cvg_ident_commands.h"
@@ -42,7 +42,8 @@ const char* kHelp =
     "and\n"
     "(unless --no-figures) PNG figures + report.md by scripts/explain_report.py.\n"
     "INPUT: t,q1,p1,q2,p2 (free decay), omega0,q1,p1,q2,p2 (forced) or raw t,f,g (demodulated\n"
-    "first at --omega or the file's omega); or a .bag of the project's messages (--topic NAME).\n";
+    "first at --omega or the file's omega); or a .bag of the project's messages (--topic NAME).\n"
+    "example: cvg_ident explain slow.csv --mode free_decay --json explain.json\n";
 
 std::vector<std::string> splitList(const std::string& s) {
   std::vector<std::string> out;

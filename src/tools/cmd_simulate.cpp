@@ -3,10 +3,10 @@
 #include <sstream>
 
 #include "cli_args.h"
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/simulate/experiment_runner.h"
 #include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_preset.h"
+#include "cvg_bench/core/simulate/experiment_runner.h"
 #include "cvg_ident_commands.h"
 
 namespace cvg_bench {
@@ -39,7 +39,9 @@ const char* kHelp =
     "  --start R,K,THETA free decay only: start from the orbit elements (5.2) amplitude R > 0,\n"
     "                    quadrature K (|K| <= R) and pattern angle THETA [rad] instead of the\n"
     "                    drive's stationary state (e.g. to probe the axes at several angles)\n"
-    "  --out FILE        output CSV\n";
+    "  --out FILE        output CSV\n"
+    "example: cvg_ident simulate --preset quartz_cylinder --mode forced --effect kappa=2 --out "
+    "q.csv\n";
 
 }  // namespace
 

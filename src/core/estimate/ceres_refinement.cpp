@@ -67,13 +67,8 @@ Eigen::VectorXd startVector(const ResonatorModel& model, const Estimate& start) 
   return z;
 }
 
-bool modelHasMu(const ResonatorModel& model) {
-  const auto& e = model.extensionNames();
-  return std::find(e.begin(), e.end(), "mu") != e.end();
-}
-
 double startMu(const Estimate& start, const CeresOptions& options) {
-  const auto it = std::find(start.names.begin(), start.names.end(), "mu");
+  const auto it = std::find(start.names.begin(), start.names.end(), ResonatorModel::muName());
   if (it != start.names.end()) {
     const double v = start.values[it - start.names.begin()];
     if (std::isfinite(v)) return v;
@@ -129,15 +124,6 @@ std::string fmt3(double v) {
   s.precision(3);
   s << v;
   return s.str();
-}
-
-ParameterEstimate interval(double value, double variance, double s_p) {
-  ParameterEstimate p;
-  p.value = value;
-  p.std_error = std::sqrt(std::max(variance, 0.0));
-  p.ci_low = value - s_p * p.std_error;
-  p.ci_high = value + s_p * p.std_error;
-  return p;
 }
 
 /// Residuals, Jacobian (unscaled unknowns) and unknowns at the solution.
@@ -483,7 +469,7 @@ Estimate refineWithCeres(const SweepRecord& record, const Estimate& start,
       throw InputError(where + ": bad value (non-finite or omega0 <= 0) at point " +
                        std::to_string(j));
   }
-  const bool estimate_mu = modelHasMu(model);
+  const bool estimate_mu = model.estimatesMu();
   const int k = model.numParameters();
   const int n_unknowns = k + (estimate_mu ? 1 : 0);
 
@@ -551,7 +537,7 @@ Estimate refineWithCeres(const SweepRecord& record, const Estimate& start,
   if (estimate_mu) {
     fp.blocks.push_back(&mu);
     fp.block_sizes.push_back(1);
-    fp.all_names.push_back("mu");
+    fp.all_names.push_back(ResonatorModel::muName());
   }
   fp.n_reported = n_unknowns;
   fp.q = &used_q;

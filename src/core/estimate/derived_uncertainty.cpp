@@ -48,12 +48,7 @@ ParameterEstimate deltaMethod(const std::function<double(const ParameterValues&)
     minus[p.cov_names[j]] = v - h;
     grad[j] = (f(plus) - f(minus)) / (2.0 * h);
   }
-  const double var = grad.dot(p.covariance * grad);
-  out.std_error = std::sqrt(std::max(0.0, var));
-  const double s_p = studentQuantile(p.confidence, p.dof);
-  out.ci_low = out.value - s_p * out.std_error;
-  out.ci_high = out.value + s_p * out.std_error;
-  return out;
+  return interval(out.value, grad.dot(p.covariance * grad), studentQuantile(p.confidence, p.dof));
 }
 
 std::map<std::string, ParameterEstimate> deriveQuantitiesWithIntervals(const UncertainParameters& p,

@@ -81,20 +81,7 @@ std::string fmt(double v) {
 }
 
 void throwIfInvalid(const IdentificationOptions& o) {
-  const auto problems = o.validate();
-  if (problems.empty()) return;
-  std::string msg = "invalid identification options:";
-  for (const auto& p : problems) msg += " " + p + ";";
-  throw InputError(msg);
-}
-
-ParameterEstimate interval(double value, double variance, double s_p) {
-  ParameterEstimate p;
-  p.value = value;
-  p.std_error = std::sqrt(std::max(0.0, variance));
-  p.ci_low = value - s_p * p.std_error;
-  p.ci_high = value + s_p * p.std_error;
-  return p;
+  cvg_bench::throwIfInvalid("invalid identification options", o.validate());
 }
 
 /// Pass 1: QR of the whole system (and RLS over the same blocks); fills the estimate's size, rank
@@ -520,8 +507,7 @@ Estimate identifyForcedRecords(const std::vector<const SweepRecord*>& records,
   throwIfInvalid(options);
   if (records.empty()) throw InputError("no sweep record given");
   const ResonatorModel model(options.model, ExperimentMode::kForced);
-  const auto& ext = model.extensionNames();
-  if (std::find(ext.begin(), ext.end(), "mu") != ext.end())
+  if (model.estimatesMu())
     throw InputError(
         "model '" + model.spec() +
         "' estimates the control nonlinearity mu, which multiplies u~ bilinearly in (3.2): linear "

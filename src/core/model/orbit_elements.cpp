@@ -87,4 +87,14 @@ double driftRate(double r, double k, double theta, const ParameterValues& p) {
          (r2 + k2) / (4 * (r2 - k2)) * ax.b_m * std::sin(4 * (theta - ax.beta));
 }
 
+std::vector<double> thetaGrid(long n) {
+  if (n < 1 || n > kMaxThetaGridPoints)
+    throw InputError("a theta grid needs 1.." + std::to_string(kMaxThetaGridPoints) +
+                     " points, got " + std::to_string(n));
+  std::vector<double> thetas;
+  thetas.reserve(n);
+  for (long i = 0; i < n; ++i) thetas.push_back(M_PI / 2 * i / n);
+  return thetas;
+}
+
 }  // namespace cvg_bench

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -21,6 +23,17 @@ struct ParameterEstimate {
   double ci_high = 0.0;    ///< value + s_p * std_error
 };
 
+/// value +- s_p x standard error with standard error sqrt(variance) (a variance below 0 from
+/// rounding counts as 0): the interval form of (2.11), s_p the quantile of the chosen distribution.
+inline ParameterEstimate interval(double value, double variance, double s_p) {
+  ParameterEstimate p;
+  p.value = value;
+  p.std_error = std::sqrt(std::max(0.0, variance));
+  p.ci_low = value - s_p * p.std_error;
+  p.ci_high = value + s_p * p.std_error;
+  return p;
+}
+
 struct Estimate {
   ExperimentMode mode = ExperimentMode::kFreeDecay;
   std::string model;         ///< canonical spec, e.g. "linear+xi"
@@ -33,11 +46,11 @@ struct Estimate {
   /// Parameters (or combinations, written as e.g. "gamma+b_c") the data cannot separate.
   std::vector<std::string> unidentifiable;
   std::string identifiability_note;  ///< why, in words (empty when full rank)
-  double sigma = 0.0;                ///< sigma-hat (2.10), in equation units (docs/paper.md item 14)
-  double confidence = 0.95;          ///< P0 of (2.11)
-  std::vector<std::string> names;    ///< parameter names in z order
-  Eigen::VectorXd values;            ///< z-hat
-  Eigen::MatrixXd covariance;        ///< covariance of z-hat (row-major order = names order)
+  double sigma = 0.0;              ///< sigma-hat (2.10), in equation units (docs/paper.md item 14)
+  double confidence = 0.95;        ///< P0 of (2.11)
+  std::vector<std::string> names;  ///< parameter names in z order
+  Eigen::VectorXd values;          ///< z-hat
+  Eigen::MatrixXd covariance;      ///< covariance of z-hat (row-major order = names order)
   std::map<std::string, ParameterEstimate> parameters;  ///< by name
   std::map<std::string, ParameterEstimate> derived;     ///< section-4 quantities with CIs
   std::vector<std::string> notes;  ///< provenance: e.g. "demodulated raw f,g at omega = ..."

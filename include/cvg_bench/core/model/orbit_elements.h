@@ -49,4 +49,10 @@ OrbitRates orbitRates(const OrbitElements& e, const ParameterValues& p);
 /// error at (r, k, theta).
 double driftRate(double r, double k, double theta, const ParameterValues& p);
 
+/// Most points a pattern-angle grid may have.
+constexpr long kMaxThetaGridPoints = 100000;
+/// n pattern angles theta_i = (pi / 2) i / n, i = 0..n-1, evenly over one period [0, pi/2) of the
+/// drift (5.9) in theta. InputError unless 1 <= n <= kMaxThetaGridPoints.
+std::vector<double> thetaGrid(long n);
+
 }  // namespace cvg_bench
