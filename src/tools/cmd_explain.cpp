@@ -17,6 +17,7 @@
 #include "cvg_bench/report/explain_json.h"
 #include "cvg_ident_commands.h"
 #include "explain_report_files.h"
+#include "cvg_bench/core/io/input_checks.h"
 
 namespace cvg_bench {
 namespace tools {
@@ -140,6 +141,8 @@ int runExplain(const std::vector<std::string>& argv) {
   RecordReadOptions read;
   read.repair_raw_timestamps = true;
   if (args.has("columns")) read.raw_columns = parseRawColumnMap(args.get("columns"));
+  if (args.has("omega")) requireOmegaInRange(id.omega_rad_s, "--omega");
+  if (args.has("json") && args.get("json") != "-") requireOutputFile(args.get("json"), "--json");
   const std::string input = args.positionals().front();
   AnyRecord rec = readRecordInput(input, read, args.get("topic"));
   std::vector<std::string> input_notes;
