@@ -496,6 +496,30 @@ class BadInputSuite(unittest.TestCase):
         for label, args in cases:
             self.check(label, args, "bad", names=(args[1],))
 
+    # ---- output paths ---------------------------------------------------------------------------
+    def test_writes_only_where_told(self):
+        """Run from an empty working directory: only the named outputs appear, nothing else."""
+        cwd = os.path.join(self.work, "cwd")
+        os.makedirs(cwd, exist_ok=True)
+        outs = os.path.join(self.work, "outs")
+        os.makedirs(outs, exist_ok=True)
+        runs = [["identify", self.slow_path, "--mode", "free_decay", "--model", "linear",
+                 "--json", os.path.join(outs, "i.json")],
+                ["explain", self.slow_path, "--mode", "free_decay", "--json",
+                 os.path.join(outs, "e.json"), "--report", os.path.join(outs, "rep"),
+                 "--no-figures"],
+                ["drift", "--params", self.base_json_path, "--json", os.path.join(outs, "d.json")],
+                ["demod", self.raw_path, "--out", os.path.join(outs, "s.csv")]]
+        for args in runs:
+            p = subprocess.run([TOOL] + args, cwd=cwd, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, universal_newlines=True, timeout=120)
+            self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertEqual(os.listdir(cwd), [])
+        self.assertEqual(sorted(os.listdir(outs)), ["d.json", "e.json", "i.json", "rep", "s.csv"])
+        self.assertTrue(set(os.listdir(os.path.join(outs, "rep"))) <=
+                        {"explain.json", "curves.csv", "residuals.csv", "signature.csv",
+                         "report.md"})
+
     # ---- drift --params JSON --------------------------------------------------------------------
     def test_params_json(self):
         with open(self.base_json_path) as f:
