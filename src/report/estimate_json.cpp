@@ -102,8 +102,8 @@ void readCovariance(const nlohmann::json& c, const std::string& path, ParameterF
       throw InputError(path + ": covariance.matrix row " + std::to_string(r) + " is not " +
                        std::to_string(n) + " numbers");
     for (size_t col = 0; col < n; ++col) {
-      const std::string at = path + ": covariance.matrix[" + std::to_string(r) + "][" +
-                             std::to_string(col) + "]";
+      const std::string at =
+          path + ": covariance.matrix[" + std::to_string(r) + "][" + std::to_string(col) + "]";
       if (!m[r][col].is_number()) throw InputError(at + " is not a number");
       f->covariance(r, col) = m[r][col].get<double>();
       requireFinite(f->covariance(r, col), at);
@@ -133,7 +133,8 @@ void readCovariance(const nlohmann::json& c, const std::string& path, ParameterF
 int readDof(const nlohmann::json& j, const char* key, const std::string& path) {
   if (!j[key].is_number_integer() || j[key].get<long long>() < 0 ||
       j[key].get<long long>() > 1000000000LL)
-    throw InputError(path + ": \"" + key + "\" must be a non-negative integer (0 = normal quantile)");
+    throw InputError(path + ": \"" + key +
+                     "\" must be a non-negative integer (0 = normal quantile)");
   return static_cast<int>(j[key].get<long long>());
 }
 

@@ -314,8 +314,8 @@ AnyRecord readRecordBag(const std::string& path, const BagReadOptions& options) 
   } catch (const rosbag::BagException& e) {
     throw InputError(path + ": not a readable rosbag (missing, truncated or corrupt): " + e.what());
   } catch (const ros::Exception& e) {  // e.g. a message cut short (stream overrun)
-    throw InputError(path + ": a message could not be decoded (truncated or corrupt bag): " +
-                     e.what());
+    throw InputError(path +
+                     ": a message could not be decoded (truncated or corrupt bag): " + e.what());
   }
   return out;
 }

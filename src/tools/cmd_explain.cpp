@@ -8,16 +8,16 @@
 #include "bag_input.h"
 #include "cli_args.h"
 #include "cvg_bench/core/demod/demodulator.h"
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/diagnose/explanation.h"
 #include "cvg_bench/core/demod/frequency_estimator.h"
 #include "cvg_bench/core/demod/irregular_demodulator.h"
+#include "cvg_bench/core/diagnose/explanation.h"
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_bench/report/explain_json.h"
 #include "cvg_ident_commands.h"
 #include "explain_report_files.h"
-#include "cvg_bench/core/io/input_checks.h"
 
 namespace cvg_bench {
 namespace tools {

@@ -4,10 +4,10 @@
 
 #include "cli_args.h"
 #include "cvg_bench/core/io/input_checks.h"
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/simulate/experiment_runner.h"
 #include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_preset.h"
+#include "cvg_bench/core/simulate/experiment_runner.h"
 #include "cvg_ident_commands.h"
 
 namespace cvg_bench {

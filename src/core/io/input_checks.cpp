@@ -87,8 +87,8 @@ void checkStateColumns(const std::vector<std::pair<std::string, const std::vecto
       if (std::fabs(v[r]) > limit)
         throw InputError(where(r, c.first) + "column '" + c.first + "': " + fmt(v[r]) +
                          " [record units] is " + fmt(std::fabs(v[r]) / typical) +
-                         " times the record's typical magnitude " + fmt(typical) +
-                         " (limit " + fmt(kMaxStateOverTypical) + "x): a corrupted sample");
+                         " times the record's typical magnitude " + fmt(typical) + " (limit " +
+                         fmt(kMaxStateOverTypical) + "x): a corrupted sample");
     }
   }
 }
@@ -97,8 +97,8 @@ void checkTimeColumn(const std::vector<double>& t_s, const std::string& name,
                      const RowLocator& where) {
   for (size_t r = 0; r < t_s.size(); ++r) {
     if (!std::isfinite(t_s[r]) || std::fabs(t_s[r]) > kMaxTimeS)
-      throw InputError(where(r, name) + "time " + fmt(t_s[r]) + " s is out of range (|t| <= " +
-                       fmt(kMaxTimeS) + " s)");
+      throw InputError(where(r, name) + "time " + fmt(t_s[r]) +
+                       " s is out of range (|t| <= " + fmt(kMaxTimeS) + " s)");
   }
   if (t_s.size() < 3) return;
   std::vector<double> dt(t_s.size() - 1);
@@ -107,10 +107,10 @@ void checkTimeColumn(const std::vector<double>& t_s, const std::string& name,
   if (!(typical > 0.0)) return;
   for (size_t r = 1; r < t_s.size(); ++r) {
     if (dt[r - 1] > kMaxIntervalOverMedian * typical)
-      throw InputError(where(r, name) + "time jumps by " + fmt(dt[r - 1]) + " s from the previous " +
-                       "sample, " + fmt(dt[r - 1] / typical) + " times the median interval " +
-                       fmt(typical) + " s (limit " + fmt(kMaxIntervalOverMedian) +
-                       "x): a clock jump");
+      throw InputError(where(r, name) + "time jumps by " + fmt(dt[r - 1]) +
+                       " s from the previous " + "sample, " + fmt(dt[r - 1] / typical) +
+                       " times the median interval " + fmt(typical) + " s (limit " +
+                       fmt(kMaxIntervalOverMedian) + "x): a clock jump");
   }
 }
 

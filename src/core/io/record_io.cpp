@@ -313,7 +313,8 @@ RawRecord toRaw(const Table& table, const RecordReadOptions& options) {
     for (auto& kv : extra) r.extra[kv.first].push_back(kv.second[i]);
   }
   const RowLocator by_table_row = table.locator();
-  checkTimeColumn(r.t_s, m.t, [&](size_t k, const std::string& c) { return by_table_row(kept[k], c); });
+  checkTimeColumn(r.t_s, m.t,
+                  [&](size_t k, const std::string& c) { return by_table_row(kept[k], c); });
   return r;
 }
 

@@ -4,8 +4,8 @@
 #include <cstring>
 #include <sstream>
 
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/estimate/internal/simd_vector4.h"
+#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 
@@ -98,7 +98,8 @@ std::vector<AcceptedRun> SampleValidator::screen(const double* t, const double* 
   const double max_abs = options_.max_abs_signal;
   const bool first_ok = std::isfinite(t[0]) && std::isfinite(f[0]) && std::isfinite(g[0]) &&
                         std::fabs(f[0]) <= max_abs && std::fabs(g[0]) <= max_abs &&
-                        !restart_pending_ && (!has_last_ || std::fabs(t[0] - last_t_ - dt_) <= tol_);
+                        !restart_pending_ &&
+                        (!has_last_ || std::fabs(t[0] - last_t_ - dt_) <= tol_);
   if (first_ok && countIrregular(t, f, g, n, dt_, tol_, max_abs) == 0) {
     runs.push_back({0, n, has_last_ ? RunStart::kContinue : RunStart::kRestartFirst, 0, 0.0});
     counters_.accepted += n;

@@ -1,5 +1,6 @@
 // Refuses records that cannot carry the answer, before any fit: exact rank alone does not see them,
-// because measurement noise makes every regressor matrix full rank (docs/paper.md, (2.7) and (3.4)).
+// because measurement noise makes every regressor matrix full rank (docs/paper.md, (2.7) and
+// (3.4)).
 //
 // Free decay (section 2): enough samples for the model's parameters; a decay signal above the
 // noise in the record as a whole and in each coordinate pair (q1, p1) of f and (q2, p2) of g (the

@@ -1,6 +1,7 @@
-// Checks on inputs before any arithmetic: files that can be read and written, and physical ranges of
-// the recorded values (interfaces.md "Input files"). Every failure is an InputError whose message
-// names the file (and line and column where the caller knows them), the quantity and its unit.
+// Checks on inputs before any arithmetic: files that can be read and written, and physical ranges
+// of the recorded values (interfaces.md "Input files"). Every failure is an InputError whose
+// message names the file (and line and column where the caller knows them), the quantity and its
+// unit.
 //
 // Why magnitudes are bounded: the regressors hold cubes and fifth powers of the states (cubic and
 // quintic stiffness, docs/paper.md), so a finite 1e300 overflows to Inf inside the solvers. A value
