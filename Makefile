@@ -45,3 +45,12 @@ clean:
 .PHONY: validate
 validate: build
 	@bash scripts/validate_all.sh
+
+# Sanitizers (ASan + UBSan): core, tool, core tests and the bad-input suite (scripts/run_asan_tests.sh).
+.PHONY: test-asan fuzz
+test-asan: deps
+	@JOBS=$(JOBS) bash scripts/run_asan_tests.sh
+
+# libFuzzer targets (clang-14) of the readers, bounded time each (scripts/run_fuzz.sh).
+fuzz: deps
+	@JOBS=$(JOBS) bash scripts/run_fuzz.sh

@@ -11,6 +11,7 @@
 #include "cvg_bench/core/demod/demodulator.h"
 #include "cvg_bench/core/demod/frequency_estimator.h"
 #include "cvg_bench/core/demod/irregular_demodulator.h"
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_ident_commands.h"
@@ -64,6 +65,12 @@ int runDemod(const std::vector<std::string>& argv) {
     std::cerr << "cvg_ident demod: " << raw.n_reordered << " rows re-ordered, "
               << raw.n_duplicates_dropped << " rows with repeated timestamps dropped\n";
 
+  if (args.has("omega")) requireOmegaInRange(args.getDouble("omega", 0.0), "--omega");
+  if (args.has("rate") && !(args.getDouble("rate", 0.0) > 0.0))
+    throw InputError("--rate must be > 0 [Hz], got " + args.get("rate"));
+  if (args.has("window") && !(args.getDouble("window", 0.0) > 0.0))
+    throw InputError("--window must be > 0 [s], got " + args.get("window"));
+  requireOutputFile(args.get("out"), "--out");
   std::vector<std::string> notes;
   double omega = args.getDouble("omega", raw.omega_rad_s);
   if (!(omega > 0.0)) {

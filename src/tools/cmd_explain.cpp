@@ -11,6 +11,7 @@
 #include "cvg_bench/core/demod/frequency_estimator.h"
 #include "cvg_bench/core/demod/irregular_demodulator.h"
 #include "cvg_bench/core/diagnose/explanation.h"
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/report/estimate_json.h"
@@ -142,6 +143,8 @@ int runExplain(const std::vector<std::string>& argv) {
   RecordReadOptions read;
   read.repair_raw_timestamps = true;
   if (args.has("columns")) read.raw_columns = parseRawColumnMap(args.get("columns"));
+  if (args.has("omega")) requireOmegaInRange(id.omega_rad_s, "--omega");
+  if (args.has("json") && args.get("json") != "-") requireOutputFile(args.get("json"), "--json");
   const std::string input = args.positionals().front();
   AnyRecord rec = readRecordInput(input, read, args.get("topic"));
   std::vector<std::string> input_notes;

@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "cli_args.h"
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_preset.h"
@@ -59,6 +60,8 @@ int runSimulate(const std::vector<std::string>& argv) {
     throw InputError("give exactly one of --preset NAME or --config FILE (see --help)");
   if (!args.has("mode")) throw InputError("--mode free_decay|forced is required");
   if (!args.has("out")) throw InputError("--out FILE is required");
+  if (args.has("config")) requireInputFile(args.get("config"), "--config preset file");
+  requireOutputFile(args.get("out"), "--out");
   ResonatorPreset preset = args.has("preset") ? loadShippedPreset(args.get("preset"))
                                               : loadResonatorPresetFile(args.get("config"));
   for (const auto& e : args.getAll("effect")) preset.applyEffect(e);

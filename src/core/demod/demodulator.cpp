@@ -270,6 +270,10 @@ void Demodulator::push(const double* t, const double* f, const double* g, size_t
       case RunStart::kRestartGap:
         restart("gap before t = " + describe(t[run.begin]) + " s: filter restarted");
         break;
+      case RunStart::kRestartBad:
+        restart("out-of-range sample dropped before t = " + describe(t[run.begin]) +
+                " s: filter state cleared");
+        break;
       case RunStart::kResetBackward:
         restart("time jumped back to t = " + describe(t[run.begin]) + " s: demodulator reset");
         break;

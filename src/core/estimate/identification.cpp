@@ -7,6 +7,7 @@
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/collinearity.h"
 #include "cvg_bench/core/estimate/correlated_noise_gram.h"
+#include "cvg_bench/core/estimate/data_sufficiency.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/forced_regression.h"
 #include "cvg_bench/core/estimate/free_decay_noise_propagation.h"
@@ -434,8 +435,8 @@ std::vector<std::string> IdentificationOptions::validate() const {
     p.push_back("method must be ls or rls (ceres: refineWithCeres), got '" + method + "'");
   if (!(confidence > 0.0 && confidence < 1.0))
     p.push_back("confidence must lie in (0, 1), got " + fmt(confidence));
-  if (!(std::isfinite(omega_rad_s) && omega_rad_s >= 0.0))
-    p.push_back("omega must be finite and >= 0 (0 = from the record), got " + fmt(omega_rad_s));
+  if (!(std::isfinite(omega_rad_s) && omega_rad_s >= 0.0 && omega_rad_s <= 1e10))
+    p.push_back("omega must be in [0, 1e10] rad/s (0 = from the record), got " + fmt(omega_rad_s));
   if (!(std::isfinite(angular_gain_k) && angular_gain_k > 0.0))
     p.push_back("angular gain K must be finite and > 0, got " + fmt(angular_gain_k));
   if (!std::isfinite(mu)) p.push_back("mu must be finite");
@@ -469,6 +470,7 @@ Estimate identifyFreeDecayRecords(const std::vector<const SlowRecord*>& records,
   for (size_t r = 0; r < records.size(); ++r) {
     const SlowRecord& rec = *records[r];
     validateFreeDecayRecord(rec);
+    if (records.size() == 1) requireSufficientData(rec, model.numParameters());
     simpson[r] = hasUniformTimes(rec, options.uniform_time_tolerance);
     info.notes.push_back(
         (rec.source.empty() ? "record " + std::to_string(r) : rec.source) + ": " +
@@ -522,6 +524,7 @@ Estimate identifyForcedRecords(const std::vector<const SweepRecord*>& records,
                                   records[0]->source.empty() ? "sweep" : records[0]->source);
   for (const SweepRecord* r : records) {
     validateSweepRecord(*r);
+    if (records.size() == 1) requireSufficientData(*r, model.numParameters());
     info.num_clusters += static_cast<long>(r->size());
   }
   info.notes.push_back(

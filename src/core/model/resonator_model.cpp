@@ -39,6 +39,9 @@ ResonatorModel::ResonatorModel(const std::string& spec, ExperimentMode mode) : m
     parts.push_back(item);
   }
   if (parts.empty()) throw InputError("empty model specification");
+  // getline drops a trailing empty item: "xi+" must fail like "xi++kappa".
+  const auto last = spec.find_last_not_of(" \t");
+  if (spec[last] == '+') throw InputError("empty term at the end of model '" + spec + "'");
   addTerms(parts, spec);
 }
 
