@@ -228,13 +228,24 @@ def label(hidden, outside):
 
 
 def tool_terms(tool):
-    """Newer library terms (presets.NEWER_TERMS) that this tool's `explain --help` names."""
+    """Newer library terms (presets.NEWER_TERMS) that this tool's `explain --help` names, as
+    "mode:term" (the help lists the candidates per mode: "free decay: a, b; forced: c, d")."""
     try:
         text = subprocess.run([tool, "explain", "--help"], stdout=subprocess.PIPE,
                               stderr=subprocess.STDOUT, universal_newlines=True).stdout
     except OSError:
         return []
-    return [t for t in presets.NEWER_TERMS if re.search(r"\b%s\b" % re.escape(t), text)]
+    text = " ".join(text.split())
+    lists = {mode: re.search(r"%s:([^;)]*)" % label, text)
+             for mode, label in (("free_decay", "free decay"), ("forced", "forced"))}
+    out = []
+    for t in presets.NEWER_TERMS:
+        if not re.search(r"\b%s\b" % re.escape(t), text):
+            continue
+        for mode, m in lists.items():
+            if m is None or re.search(r"\b%s\b" % re.escape(t), m.group(1)):
+                out.append("%s:%s" % (mode, t))
+    return out
 
 
 def tool_version(tool):

@@ -68,7 +68,8 @@ NEWER_TERMS = ["xi_k"]
 
 def library(mode, tool_terms=()):
     """(library terms, outside effects with stand-ins) for a tool that knows tool_terms."""
-    lib = LIBRARY[mode] + [t for t in NEWER_TERMS if t in tool_terms]
+    lib = LIBRARY[mode] + [t for t in NEWER_TERMS if t in tool_terms
+                           or "%s:%s" % (mode, t) in tool_terms]
     out = {k: v for k, v in OUTSIDE[mode].items() if k not in lib}
     return lib, out
 

@@ -6,8 +6,8 @@
 // amplitude-frequency law (chi' of (5.10)) and the pattern precession xi~ r k / 8 of (5.9), with a
 // fixed ratio. `xi_k` spans the other: a gyroscopic force proportional to the angular momentum
 // l = f g' - g f',
-//   F_f = -(xi_k / 2) l g',  F_g = +(xi_k / 2) l f'   (xi_k tilde-free in this form: the stored
-//   parameter is xi_k~ = xi_k omega, so F = -(xi_k~ / (2 omega)) l g', ...),
+//   F_f = -(xi_k~ / (2 omega)) l g',  F_g = +(xi_k~ / (2 omega)) l f'
+// (xi_k~ in the units of xi~, 1/(s amplitude^2), stored under the plain name `xi_k`), a force
 // which does no work (F . v = 0). Averaged, l = omega (q1 p2 - p1 q2) = omega r k, and
 //   2 (q1', p1', q2', p2') = (xi_k~ r k / 2) (-q2, -p2, q1, p1),
 // a pure rotation of the pattern: theta' = xi_k~ r k / 8, with r, k and chi unchanged. So in the
