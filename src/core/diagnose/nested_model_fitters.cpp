@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/identify_pipeline.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
 #include "cvg_bench/core/model/errors.h"
@@ -61,6 +62,16 @@ class FreeDecayFitter : public NestedModelFitter {
 
   NestedFit fit(const std::vector<std::string>& extensions) const override {
     return fitOn(record_, extensions);
+  }
+
+  NestedFit fitEquationError(const std::vector<std::string>& extensions) const override {
+    IdentificationOptions o = options_.identification;
+    o.model = modelSpecOf(extensions);
+    return fitSystem(buildFreeDecaySystem({record_}, o), o, extensions);
+  }
+  bool refinesByOutputError() const override { return true; }
+  std::vector<double> knownNoiseCorrelation() const override {
+    return noiseCorrelationFromMetadata(record_.metadata);
   }
 
   double holdoutRms(const std::vector<std::string>& extensions) const override {
