@@ -66,7 +66,7 @@ class FreeDecayFitter : public NestedModelFitter {
 
   NestedFit fitEquationError(const std::vector<std::string>& extensions) const override {
     IdentificationOptions o = options_.identification;
-    o.model = modelSpecOf(extensions);
+    o.model = ResonatorModel(extensions, ExperimentMode::kFreeDecay).spec();
     return fitSystem(buildFreeDecaySystem({record_}, o), o, extensions);
   }
   bool refinesByOutputError() const override { return true; }

@@ -46,8 +46,11 @@ double ratio(double a, double b) {
   return a / b;
 }
 
+/// The subset as a model specification ("linear+xi+..."), its key in the tables.
 std::string key(const Terms& t) {
-  return modelSpecOf(t);
+  std::string s = "linear";
+  for (const auto& e : t) s += "+" + e;
+  return s;
 }
 
 /// All subsets of `names` with up to `max_size` elements, in candidate order, smallest first.
@@ -211,7 +214,7 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     if (!f) continue;
     SubsetScore s;
     s.terms = t;
-    s.model = modelSpecOf(t);
+    s.model = key(t);
     s.criterion_ls = search.criterion(*f, t.size(), c_ls);
     s.criterion = s.criterion_ls;
     s.sigma = f->sigma;
@@ -408,7 +411,7 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
       if (key(s.terms) == key(t)) return s;
     SubsetScore s;
     s.terms = t;
-    s.model = modelSpecOf(t);
+    s.model = key(t);
     return s;
   };
   result.chosen = scoreOf(chosen_c);
