@@ -11,13 +11,17 @@ CATKIN_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release -
 deps:
 	@bash scripts/install_deps.sh
 
-# The package is linked into the workspace under a hidden source folder (.src): roslib's resource
-# search walks the package (following links) and skips only hidden folders, so a visible link back
-# to the repository from inside build/ would loop (`roslaunch cvg_bench X.launch` failed).
+# The package appears in the workspace as build/ws/.src/cvg_bench: a folder holding one link per
+# top-level entry of the repository except build/. A single link back to the repository would put
+# a loop under the package (the link sits inside build/), which `rosrun` (find -L) reports as
+# "File system loop detected" and roslib's resource search walks repeatedly.
 build: deps
 	@if [ -e $(WS)/src ]; then echo "make build: moving to the .src layout (full rebuild)"; rm -rf $(WS); fi
 	@mkdir -p $(WS)/.src
-	@ln -sfn ../../.. $(WS)/.src/cvg_bench
+	@if [ -L $(WS)/.src/cvg_bench ]; then rm $(WS)/.src/cvg_bench; fi
+	@mkdir -p $(WS)/.src/cvg_bench
+	@find $(WS)/.src/cvg_bench -maxdepth 1 -type l -delete
+	@for e in $$(ls -A); do case "$$e" in build|.git) ;; *) ln -sfn "../../../../$$e" "$(WS)/.src/cvg_bench/$$e";; esac; done
 	@cd $(WS) && catkin_make --source .src $(CATKIN_ARGS) -j$(JOBS) > ../catkin_build.log 2>&1 \
 	  || { tail -n 60 ../catkin_build.log; echo "make build: failed (full log: build/catkin_build.log)"; exit 1; }
 	@echo "make build: ok (tool: bin/cvg_ident)"
@@ -41,3 +45,12 @@ clean:
 .PHONY: validate
 validate: build
 	@bash scripts/validate_all.sh
+
+# Sanitizers (ASan + UBSan): core, tool, core tests and the bad-input suite (scripts/run_asan_tests.sh).
+.PHONY: test-asan fuzz
+test-asan: deps
+	@JOBS=$(JOBS) bash scripts/run_asan_tests.sh
+
+# libFuzzer targets (clang-14) of the readers, bounded time each (scripts/run_fuzz.sh).
+fuzz: deps
+	@JOBS=$(JOBS) bash scripts/run_fuzz.sh

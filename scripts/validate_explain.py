@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Seeded batch validation of `cvg_ident explain` (issue 5, item 3).
+"""Seeded batch validation of `cvg_ident explain` (docs/validation_explain.md).
 
 For each seed an effect is drawn from the library (or none: clean data), the record is simulated by
 `cvg_ident simulate` on the mems_ring preset with its own cubic stiffness switched off, and

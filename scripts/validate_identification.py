@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Monte Carlo validation of the identification (issue 4 item 9).
+"""Monte Carlo validation of the identification (docs/validation.md).
 
 Runs the DISABLED Monte Carlo gtests of test/core/ceres_refinement_test.cpp (seeded simulations of
 the averaged model, estimators from the core library) and summarises them:

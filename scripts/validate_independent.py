@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Independent validation of `cvg_ident explain` and of `cvg_ident identify`'s intervals
-(issue 11, item 1): records made by a path the fit does not share, scored against fixed targets.
+(docs/validation_independent.md): records made by a path the fit does not share, scored against fixed targets.
 
 Data (scripts/independent_model/, written from the paper, never `cvg_ident simulate`):
   fd_slow   free decay t,q1,p1,q2,p2 of the averaged model (numerical averaging of the forces of
@@ -53,7 +53,7 @@ from independent_model import averaged, full, noise, presets, records, selfcheck
 
 SEED0 = 50000
 KINDS = ["fd_slow", "sweep", "fd_raw", "cov_fd_ar1", "cov_sweep_ar1", "cov_raw"]
-# Targets, fixed before running (issue 11).
+# Targets, fixed before running.
 TARGET_CORRECT = 0.95
 TARGET_FALSE_ALARM = 0.05
 TARGET_COVERAGE = (0.90, 0.98)

@@ -50,6 +50,16 @@ def truth_of(path):
     return truth
 
 
+def wilson(k, n, z=1.96):
+    """Wilson 95 % interval of a binomial rate k / n."""
+    if n == 0:
+        return (float("nan"), float("nan"))
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return (centre - half, centre + half)
+
+
 def run(cmd):
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
@@ -69,6 +79,7 @@ def main():
     raw, out = os.path.join(work, "raw.csv"), os.path.join(work, "est.json")
     methods = ("ls", "ceres")
     stats = {m: {} for m in methods}
+    ids = {m: {} for m in methods}
     lag2 = []
     samples = 0
     for seed in range(SEED0, SEED0 + runs):
@@ -81,6 +92,8 @@ def main():
             with open(out) as f:
                 est = json.load(f)
             samples = est.get("n_equations", 0) // 4 + 2
+            mid = est.get("interval_method_id", "")
+            ids[m][mid] = ids[m].get(mid, 0) + 1
             if m == "ls":
                 found = LAG2.search(proc.stdout + proc.stderr)
                 if found:
@@ -112,10 +125,11 @@ def main():
         total = sum(len(s["err"]) for s in stats[m].values())
         covered = sum(s["cov"] for s in stats[m].values())
         lo, hi = wilson(covered, total)
-        lines += ["## %s: coverage %.3f over %d intervals (Wilson 95 %%: %.3f-%.3f, treating the "
-                  "intervals as independent)" % ("LS, honest intervals" if m == "ls" else
-                                                 "Ceres output error", covered / total, total, lo,
-                                                 hi),
+        lines += ["## %s: coverage %.3f [%.3f, %.3f] over %d intervals" % (
+            "LS, honest intervals" if m == "ls" else "Ceres output error", covered / total, lo, hi,
+            total), "",
+            "Interval methods used (interval_method_id: runs): " +
+            ", ".join("%s: %d" % kv for kv in sorted(ids[m].items())),
             "", "| parameter | coverage | mean SE | RMS error | SE / RMS | bias / RMS |",
             "|---|---|---|---|---|---|"]
         for name, s in stats[m].items():

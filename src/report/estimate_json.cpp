@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
@@ -12,6 +13,36 @@ namespace {
 
 nlohmann::json parameterToJson(const ParameterEstimate& p) {
   return {{"value", p.value}, {"std", p.std_error}, {"ci_low", p.ci_low}, {"ci_high", p.ci_high}};
+}
+
+/// Which method made the intervals, the residuals' serial correlation, near-collinearity.
+void addIntervalDiagnostics(const Estimate& e, nlohmann::json* out) {
+  nlohmann::json& j = *out;
+  if (!e.interval_method_id.empty()) {
+    j["interval_method_id"] = e.interval_method_id;
+    j["residual_correlation"] = {{"lag1", e.residual_lag1},
+                                 {"lag1_expected_independent", e.residual_lag1_expected},
+                                 {"z", e.residual_lag1_z},
+                                 {"correlated", e.residual_correlated},
+                                 {"noise_model", e.noise_model}};
+  }
+  if (!e.vif.empty()) {
+    nlohmann::json weak = nlohmann::json::array();
+    for (const auto& w : e.weak_directions)
+      weak.push_back({{"direction_column_normalized", w.first}, {"singular_value", w.second}});
+    j["identifiability"] = {{"condition_number", e.condition_number},
+                            {"vif", e.vif},
+                            {"weak_directions", weak},
+                            {"not_identified", e.not_identified}};
+  }
+  j["not_identified"] = e.not_identified;
+  for (const auto& name : e.not_identified) {
+    if (!j["parameters"].contains(name)) continue;
+    j["parameters"][name]["identified"] = false;
+    j["parameters"][name]["note"] =
+        "not identified by this record (see identifiable_combinations and identifiability)";
+  }
+  if (!e.derived_method.empty()) j["derived_method"] = e.derived_method;
 }
 
 }  // namespace
@@ -66,17 +97,88 @@ nlohmann::json estimateToJson(const Estimate& e) {
     j["identifiable_combinations"] = comb;
   }
   if (!e.singular_values.empty()) j["singular_values"] = e.singular_values;
+  addIntervalDiagnostics(e, &j);
   j["notes"] = e.notes;
   return j;
 }
 
+namespace {
+
+/// The covariance member: names (strings, each a parameter of the file), an n x n matrix of numbers
+/// with non-negative variances on the diagonal, symmetric, and correlations within [-1, 1].
+void readCovariance(const nlohmann::json& c, const std::string& path, ParameterFile* f) {
+  if (!c.is_object() || !c.contains("names") || !c.contains("matrix"))
+    throw InputError(path + ": covariance needs \"names\" and \"matrix\"");
+  const auto& names = c["names"];
+  if (!names.is_array()) throw InputError(path + ": covariance.names must be an array of names");
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (!names[i].is_string())
+      throw InputError(path + ": covariance.names[" + std::to_string(i) + "] is not a string");
+    const std::string name = names[i].get<std::string>();
+    if (!f->values.count(name))
+      throw InputError(path + ": covariance.names[" + std::to_string(i) + "] '" + name +
+                       "' is not one of the file's parameters");
+    for (const auto& earlier : f->cov_names)
+      if (earlier == name) throw InputError(path + ": covariance.names: '" + name + "' twice");
+    f->cov_names.push_back(name);
+  }
+  const size_t n = f->cov_names.size();
+  const auto& m = c["matrix"];
+  if (!m.is_array() || m.size() != n)
+    throw InputError(path + ": covariance.matrix is not " + std::to_string(n) + " x " +
+                     std::to_string(n));
+  f->covariance.resize(n, n);
+  for (size_t r = 0; r < n; ++r) {
+    if (!m[r].is_array() || m[r].size() != n)
+      throw InputError(path + ": covariance.matrix row " + std::to_string(r) + " is not " +
+                       std::to_string(n) + " numbers");
+    for (size_t col = 0; col < n; ++col) {
+      const std::string at =
+          path + ": covariance.matrix[" + std::to_string(r) + "][" + std::to_string(col) + "]";
+      if (!m[r][col].is_number()) throw InputError(at + " is not a number");
+      f->covariance(r, col) = m[r][col].get<double>();
+      requireFinite(f->covariance(r, col), at);
+    }
+  }
+  for (size_t r = 0; r < n; ++r) {
+    const double vr = f->covariance(r, r);
+    if (vr < 0.0)
+      throw InputError(path + ": covariance.matrix[" + std::to_string(r) + "][" +
+                       std::to_string(r) + "]: variance of " + f->cov_names[r] + " is negative (" +
+                       std::to_string(vr) + ")");
+    for (size_t col = 0; col < r; ++col) {
+      const double a = f->covariance(r, col), b = f->covariance(col, r);
+      const double bound = std::sqrt(vr * f->covariance(col, col));
+      const double tol = 1e-9 * (bound + std::fabs(a) + std::fabs(b)) + 1e-300;
+      if (std::fabs(a - b) > tol)
+        throw InputError(path + ": covariance.matrix is not symmetric at [" + std::to_string(r) +
+                         "][" + std::to_string(col) + "]");
+      if (std::fabs(a) > bound * (1.0 + 1e-9) + 1e-300)
+        throw InputError(path + ": covariance.matrix[" + std::to_string(r) + "][" +
+                         std::to_string(col) + "]: |covariance| of " + f->cov_names[r] + ", " +
+                         f->cov_names[col] + " exceeds the product of their standard deviations");
+    }
+  }
+}
+
+int readDof(const nlohmann::json& j, const char* key, const std::string& path) {
+  if (!j[key].is_number_integer() || j[key].get<long long>() < 0 ||
+      j[key].get<long long>() > 1000000000LL)
+    throw InputError(path + ": \"" + key +
+                     "\" must be a non-negative integer (0 = normal quantile)");
+  return static_cast<int>(j[key].get<long long>());
+}
+
+}  // namespace
+
 ParameterFile readParameterFile(const std::string& path) {
+  requireInputFile(path, "parameter file");
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open parameter file");
   nlohmann::json j;
   try {
     in >> j;
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {
     throw InputError(path + ": not valid JSON (" + e.what() + ")");
   }
   ParameterFile f;
@@ -85,7 +187,7 @@ ParameterFile readParameterFile(const std::string& path) {
   if (!j.contains("omega") || !j["omega"].is_number())
     throw InputError(path + ": needs a number member \"omega\" (natural frequency, rad/s)");
   f.omega_rad_s = j["omega"].get<double>();
-  requirePositive(f.omega_rad_s, path + ": omega");
+  requireOmegaInRange(f.omega_rad_s, path + ": \"omega\"");
   for (const auto& kv : j["parameters"].items()) {
     double v;
     if (kv.value().is_number()) {
@@ -100,30 +202,17 @@ ParameterFile readParameterFile(const std::string& path) {
     requireFinite(v, path + ": parameter " + kv.key());
     f.values[kv.key()] = v;
   }
-  if (j.contains("dof") && j["dof"].is_number_integer()) f.dof = j["dof"].get<int>();
+  if (j.contains("dof")) f.dof = readDof(j, "dof", path);
   // The intervals of "parameters" use interval_dof (the honest covariance's quantile).
-  if (j.contains("interval_dof") && j["interval_dof"].is_number_integer())
-    f.dof = j["interval_dof"].get<int>();
-  if (j.contains("confidence") && j["confidence"].is_number())
+  if (j.contains("interval_dof")) f.dof = readDof(j, "interval_dof", path);
+  if (j.contains("confidence")) {
+    if (!j["confidence"].is_number() || !(j["confidence"].get<double>() > 0.0) ||
+        !(j["confidence"].get<double>() < 1.0))
+      throw InputError(path + ": \"confidence\" must be a number in (0, 1)");
     f.confidence = j["confidence"].get<double>();
-  if (j.contains("covariance") && j["covariance"].is_object()) {
-    const auto& c = j["covariance"];
-    if (!c.contains("names") || !c.contains("matrix"))
-      throw InputError(path + ": covariance needs \"names\" and \"matrix\"");
-    f.cov_names = c["names"].get<std::vector<std::string>>();
-    const size_t n = f.cov_names.size();
-    const auto& m = c["matrix"];
-    if (!m.is_array() || m.size() != n) throw InputError(path + ": covariance matrix is not n x n");
-    f.covariance.resize(n, n);
-    for (size_t r = 0; r < n; ++r) {
-      if (!m[r].is_array() || m[r].size() != n)
-        throw InputError(path + ": covariance matrix is not n x n");
-      for (size_t col = 0; col < n; ++col) {
-        f.covariance(r, col) = m[r][col].get<double>();
-        requireFinite(f.covariance(r, col), path + ": covariance entry");
-      }
-    }
   }
+  if (j.contains("covariance") && !j["covariance"].is_null())
+    readCovariance(j["covariance"], path, &f);
   return f;
 }
 
@@ -132,9 +221,12 @@ void writeJsonFile(const nlohmann::json& j, const std::string& path) {
     std::cout << j.dump(2) << "\n";
     return;
   }
+  requireOutputFile(path, "JSON output");
   std::ofstream out(path);
   if (!out) throw InputError(path + ": cannot write");
   out << j.dump(2) << "\n";
+  out.close();
+  if (!out) throw InputError(path + ": write failed (disk full?)");
 }
 
 }  // namespace report

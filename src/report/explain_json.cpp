@@ -25,7 +25,35 @@ nlohmann::json stepToJson(const SelectionStep& s) {
           {"threshold", s.threshold},
           {"delta_bic", finiteOrNull(s.delta_bic)},
           {"holdout_ratio", finiteOrNull(s.holdout_ratio)},
+          {"delta_criterion", finiteOrNull(s.delta_criterion)},
           {"accepted", s.accepted}};
+}
+
+nlohmann::json subsetToJson(const SubsetScore& s) {
+  return {{"model", s.model},
+          {"terms", s.terms},
+          {"criterion_ls", finiteOrNull(s.criterion_ls)},
+          {"refined", s.refined},
+          {"criterion", finiteOrNull(s.criterion)},
+          {"sigma", s.sigma},
+          {"holdout_ratio", s.holdout_ratio > 0 ? finiteOrNull(s.holdout_ratio) : nullptr}};
+}
+
+/// The selection's criterion, the chosen subset, the runner-up and the table of subsets.
+nlohmann::json selectionToJson(const SelectionResult& sel) {
+  nlohmann::json subsets = nlohmann::json::array();
+  for (const auto& s : sel.subsets) subsets.push_back(subsetToJson(s));
+  nlohmann::json runner = nullptr;
+  if (!sel.runner_up.model.empty()) {
+    runner = subsetToJson(sel.runner_up);
+    runner["delta_criterion"] = finiteOrNull(sel.runner_up_delta);
+  }
+  return {{"criterion", sel.criterion_description},
+          {"correlation_factor_ls", sel.correlation_factor_ls},
+          {"correlation_factor", sel.correlation_factor},
+          {"chosen", subsetToJson(sel.chosen)},
+          {"runner_up", runner},
+          {"subsets", subsets}};
 }
 
 nlohmann::json signatureToJson(const ResidualSignature& sig) {
@@ -50,10 +78,19 @@ nlohmann::json explanationToJson(const Explanation& x) {
   j["steps"] = steps;
   j["selected"] = x.selection.selected;
   j["dropped"] = x.selection.dropped;
+  j["selection"] = selectionToJson(x.selection);
+  j["runner_up"] =
+      x.selection.runner_up.model.empty()
+          ? nlohmann::json(nullptr)
+          : nlohmann::json({{"model", x.selection.runner_up.model},
+                            {"terms", x.selection.runner_up.terms},
+                            {"delta_criterion", finiteOrNull(x.selection.runner_up_delta)}});
   j["unexplained"] = x.unexplained;
   j["lack_of_fit"] = {{"test", x.lack_of_fit.test},
                       {"p_value", x.lack_of_fit.p_value},
-                      {"worst", x.lack_of_fit.worst}};
+                      {"worst", x.lack_of_fit.worst},
+                      {"noise_model", x.lack_of_fit.noise_model},
+                      {"p_value_unwhitened", x.lack_of_fit.p_value_unwhitened}};
   j["cause"] = x.cause;
   nlohmann::json rejected = nlohmann::json::array();
   for (const auto& s : x.selection.last_round) rejected.push_back(stepToJson(s));

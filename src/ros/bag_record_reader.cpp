@@ -2,6 +2,7 @@
 // conversions.h.
 #include "cvg_bench/ros/bag_record_reader.h"
 
+#include <ros/exception.h>
 #include <ros/message_traits.h>
 #include <rosbag/bag.h>
 #include <rosbag/exceptions.h>
@@ -14,6 +15,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/ros/conversions.h"
 
@@ -130,6 +132,25 @@ std::string where(const std::string& path, const std::string& topic, size_t inde
   return path + ": topic '" + topic + "' message " + std::to_string(index + 1) + ": ";
 }
 
+/// Range checks (input_checks.h) of a record's columns; rows are messages (slow, sweep) or samples.
+RowLocator messageLocator(const std::string& path, const std::string& topic) {
+  return [path, topic](size_t r, const std::string&) { return where(path, topic, r); };
+}
+RowLocator sampleLocator(const std::string& path, const std::string& topic) {
+  return [path, topic](size_t r, const std::string&) {
+    return path + ": topic '" + topic + "' sample " + std::to_string(r + 1) + " (in time order): ";
+  };
+}
+void checkStates(const std::vector<Eigen::Vector4d>& q, const RowLocator& at) {
+  std::vector<std::vector<double>> c(4, std::vector<double>(q.size()));
+  for (size_t r = 0; r < q.size(); ++r)
+    for (int k = 0; k < 4; ++k) c[k][r] = q[r][k];
+  checkStateColumns({{"q1", &c[0]}, {"p1", &c[1]}, {"q2", &c[2]}, {"p2", &c[3]}}, at);
+}
+void checkOmega(double omega_rad_s, const std::string& path, const std::string& topic) {
+  if (omega_rad_s != 0.0) requireOmegaInRange(omega_rad_s, path + ": topic '" + topic + "'");
+}
+
 void readSlow(const rosbag::Bag& bag, const std::string& path, const std::string& topic,
               const TopicInfo& info, AnyRecord* out) {
   const auto msgs = readAll<SlowState>(bag, path, topic, info);
@@ -153,6 +174,9 @@ void readSlow(const rosbag::Bag& bag, const std::string& path, const std::string
   rec.omega_rad_s = msgs.front()->reference_frequency_rad_s > 0.0
                         ? msgs.front()->reference_frequency_rad_s - msgs.front()->detuning_rad_s
                         : 0.0;
+  checkTimeColumn(rec.t_s, "stamp", messageLocator(path, topic));
+  checkStates(rec.q, messageLocator(path, topic));
+  checkOmega(rec.omega_rad_s, path, topic);
   rec.metadata["mode"] = "free_decay";
   rec.metadata["stamp_origin"] = stampText(origin);
   setOmegaMetadata(rec.omega_rad_s, &rec.metadata);
@@ -175,6 +199,9 @@ void readSweep(const rosbag::Bag& bag, const std::string& path, const std::strin
     rec.direction.insert(rec.direction.begin(), rec.size() - rec.direction.size(), 0);
     rec.jump.insert(rec.jump.begin(), rec.size() - rec.jump.size(), 0);
   }
+  checkExcitationColumn(rec.omega0_rad_s, "omega0", messageLocator(path, topic));
+  checkStates(rec.q, messageLocator(path, topic));
+  checkOmega(rec.omega_rad_s, path, topic);
   rec.metadata["mode"] = "forced";
   rec.metadata["stamp_origin"] = stampText(msgs.front()->header.stamp);
   setOmegaMetadata(rec.omega_rad_s, &rec.metadata);
@@ -244,6 +271,9 @@ void readRaw(const rosbag::Bag& bag, const std::string& path, const std::string&
     rec.g.swap(sorted.g);
     omega0.swap(omega0_sorted);
   }
+  checkTimeColumn(rec.t_s, "t", sampleLocator(path, topic));
+  checkStateColumns({{"f", &rec.f}, {"g", &rec.g}}, sampleLocator(path, topic));
+  checkOmega(rec.omega_rad_s, path, topic);
   if (driven) rec.extra["omega0"] = omega0;
   rec.metadata["mode"] = driven ? "forced" : "free_decay";
   rec.metadata["stamp_origin"] = stampText(origin);
@@ -259,6 +289,7 @@ bool isBagPath(const std::string& path) {
 
 AnyRecord readRecordBag(const std::string& path, const BagReadOptions& options) {
   if (options.kinds.empty()) throw InputError("readRecordBag: no acceptable record kind given");
+  requireInputFile(path, "input bag");
   AnyRecord out;
   try {
     rosbag::Bag bag;
@@ -282,6 +313,9 @@ AnyRecord readRecordBag(const std::string& path, const BagReadOptions& options) 
     }
   } catch (const rosbag::BagException& e) {
     throw InputError(path + ": not a readable rosbag (missing, truncated or corrupt): " + e.what());
+  } catch (const ros::Exception& e) {  // e.g. a message cut short (stream overrun)
+    throw InputError(path +
+                     ": a message could not be decoded (truncated or corrupt bag): " + e.what());
   }
   return out;
 }

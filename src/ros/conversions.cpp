@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_model.h"
 
@@ -80,6 +81,8 @@ RawSampleBatch rawBatchToMsg(const RawRecord& record, size_t begin, size_t end,
 Eigen::Vector4d slowFromMsg(const SlowState& msg) {
   const Eigen::Vector4d q(msg.q1, msg.p1, msg.q2, msg.p2);
   if (!q.allFinite()) throw InputError("SlowState has a non-finite q1, p1, q2 or p2");
+  if (q.cwiseAbs().maxCoeff() > kMaxStateMagnitude)
+    throw InputError("SlowState q1, p1, q2 or p2 beyond 1e30 [amplitude units] (corrupted)");
   return q;
 }
 
@@ -118,6 +121,8 @@ SweepPoint sweepPointToMsg(const SweepRecord& record, size_t i, const ros::Time&
 void appendSweepPoint(const SweepPoint& msg, SweepRecord* record) {
   const Eigen::Vector4d q(msg.q1, msg.p1, msg.q2, msg.p2);
   if (!q.allFinite()) throw InputError("SweepPoint has a non-finite q1, p1, q2 or p2");
+  if (q.cwiseAbs().maxCoeff() > kMaxStateMagnitude)
+    throw InputError("SweepPoint q1, p1, q2 or p2 beyond 1e30 [amplitude units] (corrupted)");
   if (!(std::isfinite(msg.omega0_rad_s) && msg.omega0_rad_s > 0.0))
     throw InputError("SweepPoint has omega0_rad_s <= 0 or not finite");
   if (record->omega_rad_s <= 0.0 && std::isfinite(msg.omega_rad_s) && msg.omega_rad_s > 0.0)

@@ -56,7 +56,7 @@ void DemodulatorNode::resetState(const std::string& why) {
   ROS_WARN("demodulator reset: %s", why.c_str());
 }
 
-bool DemodulatorNode::onReset(Reset::Request&, Reset::Response& res) {
+bool DemodulatorNode::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   resetState("reset requested");
   res.success = true;
   res.message = "demodulator reset";

@@ -10,9 +10,9 @@
 #include "cvg_bench/DerivedQuantitiesStamped.h"
 #include "cvg_bench/DriftRate.h"
 #include "cvg_bench/ModelEstimate.h"
+#include "cvg_bench/core/diagnose/explanation.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
 #include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/diagnose/explanation.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/report/explain_json.h"
 #include "cvg_bench/ros/conversions.h"
@@ -200,17 +200,22 @@ SlowRecord IdentifierNode::bufferedSlowRecord() const {
 }
 
 void IdentifierNode::identifyNow(const IdentificationOptions& options) {
+  // The window's batch estimate is the honest least-squares one (in `rls` mode the same z at
+  // forgetting 1 as the streaming estimate, docs/paper.md item 9, with honest intervals).
+  PipelineOptions batch;
+  batch.method = Method::kLs;
+  batch.identification = options;
+  identifyNow(batch);
+}
+
+void IdentifierNode::identifyNow(const PipelineOptions& options) {
   const int have = static_cast<int>(stamps_.size());
   if (have < options_.min_samples)
     throw InputError("only " + std::to_string(have) +
                      (mode_ == ExperimentMode::kFreeDecay ? " slow states" : " sweep points") +
                      " buffered; min_samples is " + std::to_string(options_.min_samples));
-  // In `rls` mode the recursive estimate streams already; the window's batch estimate is the
-  // honest least-squares one (same z at forgetting 1, docs/paper.md item 9, with honest intervals).
-  IdentificationOptions batch = options;
-  if (batch.method == "rls") batch.method = "ls";
-  Estimate e = mode_ == ExperimentMode::kFreeDecay ? identifyFreeDecay(bufferedSlowRecord(), batch)
-                                                   : identifyForced(sweep_, batch);
+  const Estimate e = mode_ == ExperimentMode::kFreeDecay ? identify(bufferedSlowRecord(), options)
+                                                         : identify(sweep_, options);
   estimate_ = e;
   window_start_ = stamps_.front();
   window_end_ = stamps_.back();
@@ -303,19 +308,21 @@ void IdentifierNode::publishFrames() {
 }
 
 bool IdentifierNode::onIdentify(Identify::Request& req, Identify::Response& res) {
-  IdentificationOptions o = options_.identification;
-  if (!req.model.empty()) o.model = req.model;
-  if (!req.method.empty()) o.method = req.method;
-  if (req.confidence != 0.0) o.confidence = req.confidence;
+  // Every method of the pipeline: ls, rls (batch recursive (2.12)) and ceres (output error).
+  PipelineOptions o;
+  o.identification = options_.identification;
+  if (!req.model.empty()) o.identification.model = req.model;
+  if (req.confidence != 0.0) o.identification.confidence = req.confidence;
   try {
+    o.method = parseMethod(req.method.empty() ? options_.identification.method : req.method);
     throwIfProblems("identify request", o.validate());
     identifyNow(o);
     res.success = estimate_.rank == estimate_.n_params;
     res.message = summary(estimate_, window_samples_);
     res.estimate = estimateToMsg(estimate_, window_start_, window_end_, window_samples_);
     res.estimate.header.frame_id = options_.frame_id;
-    res.derived =
-        derivedToMsg(estimate_.derived, window_end_, estimate_.confidence, o.angular_gain_k);
+    res.derived = derivedToMsg(estimate_.derived, window_end_, estimate_.confidence,
+                               o.identification.angular_gain_k);
   } catch (const std::exception& e) {
     res.success = false;
     res.message = e.what();
@@ -377,7 +384,7 @@ bool IdentifierNode::onPredictDrift(PredictDrift::Request& req, PredictDrift::Re
   return true;
 }
 
-bool IdentifierNode::onReset(Reset::Request&, Reset::Response& res) {
+bool IdentifierNode::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   clearData("reset requested");
   have_estimate_ = false;
   estimate_ = Estimate();

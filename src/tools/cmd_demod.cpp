@@ -9,10 +9,11 @@
 #include "bag_input.h"
 #include "cli_args.h"
 #include "cvg_bench/core/demod/demodulator.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/demod/frequency_estimator.h"
 #include "cvg_bench/core/demod/irregular_demodulator.h"
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_ident_commands.h"
 
 namespace cvg_bench {
@@ -37,7 +38,8 @@ const char* kHelp =
     "  --window S     least-squares window for irregular timestamps [s] (default 2 / rate).\n"
     "Uniform timestamps (every interval within 1 % of the median, or a whole multiple of it for\n"
     "dropped samples) use the FIR path (passband 0.2 x rate, stopband 0.5 x rate); otherwise the\n"
-    "windowed least-squares path is used. The choice is printed on stderr and in the output.\n";
+    "windowed least-squares path is used. The choice is printed on stderr and in the output.\n"
+    "example: cvg_ident demod raw.csv --rate 200 --out slow_200hz.csv\n";
 
 }  // namespace
 
@@ -63,6 +65,12 @@ int runDemod(const std::vector<std::string>& argv) {
     std::cerr << "cvg_ident demod: " << raw.n_reordered << " rows re-ordered, "
               << raw.n_duplicates_dropped << " rows with repeated timestamps dropped\n";
 
+  if (args.has("omega")) requireOmegaInRange(args.getDouble("omega", 0.0), "--omega");
+  if (args.has("rate") && !(args.getDouble("rate", 0.0) > 0.0))
+    throw InputError("--rate must be > 0 [Hz], got " + args.get("rate"));
+  if (args.has("window") && !(args.getDouble("window", 0.0) > 0.0))
+    throw InputError("--window must be > 0 [s], got " + args.get("window"));
+  requireOutputFile(args.get("out"), "--out");
   std::vector<std::string> notes;
   double omega = args.getDouble("omega", raw.omega_rad_s);
   if (!(omega > 0.0)) {

@@ -30,7 +30,39 @@ const char* kHelp =
     "angles on [0, pi/2). Also prints section 4's derived quantities (angular gain K, default "
     "0.4).\n"
     "When the params file carries a covariance (identify --json), every figure gets a confidence\n"
-    "interval by the delta method (numerical Jacobian; the file's confidence and interval_dof).\n";
+    "interval by the delta method (numerical Jacobian; the file's confidence and interval_dof).\n"
+    "At one state (--r --k --theta) it also prints the amplitude envelope's decay rate\n"
+    "-2 r'/r of (5.7) and the Q = omega / rate it implies (JSON \"envelope\").\n"
+    "example: cvg_ident drift --params est.json --r 0.5 --k 0.1 --theta 0.3\n";
+
+/// The amplitude envelope's decay at one state, from (5.7): rate = -2 r'/r [1/s] and the quality
+/// factor Q = omega / rate that a ring-down at this state shows, with the rate's CI (delta method)
+/// mapped to Q. Unlike omega / gamma it needs only the combination of gamma, b_c, b_s and n that
+/// the record determines (a single standing wave does not separate them, docs/paper.md item 11).
+nlohmann::json envelopeDecay(double r, double k, double theta, const UncertainParameters& up,
+                             double omega_rad_s) {
+  const OrbitElements e{r, k, theta, 0.0};
+  const ParameterEstimate rate =
+      deltaMethod([&](const ParameterValues& v) { return -2.0 * orbitRates(e, v).r_dot / r; }, up);
+  nlohmann::json j = {{"decay_rate_1_s", rate.value},
+                      {"Q", omega_rad_s / rate.value},
+                      {"method", "amplitude envelope decay -2 r'/r of (5.7) at (r, k, theta)"}};
+  std::cout << std::setprecision(6) << "envelope decay (5.7) at r = " << r << ", k = " << k
+            << ", theta = " << theta << ": -2 r'/r = " << rate.value
+            << " 1/s, Q = omega / rate = " << omega_rad_s / rate.value;
+  if (!up.cov_names.empty()) {
+    j["std_1_s"] = rate.std_error;
+    j["ci_low_1_s"] = rate.ci_low;
+    j["ci_high_1_s"] = rate.ci_high;
+    if (rate.ci_low > 0.0) {
+      j["Q_ci_low"] = omega_rad_s / rate.ci_high;
+      j["Q_ci_high"] = omega_rad_s / rate.ci_low;
+      std::cout << " [" << omega_rad_s / rate.ci_high << ", " << omega_rad_s / rate.ci_low << "]";
+    }
+  }
+  std::cout << "\n";
+  return j;
+}
 
 }  // namespace
 
@@ -52,9 +84,7 @@ int runDrift(const std::vector<std::string>& argv) {
   if (args.has("theta")) {
     thetas.push_back(args.getDouble("theta", 0.0));
   } else {
-    const long n = args.getInt("theta-grid", 8);
-    if (n < 1 || n > 100000) throw InputError("--theta-grid needs 1..100000 points");
-    for (long i = 0; i < n; ++i) thetas.push_back(M_PI / 2 * i / n);
+    thetas = thetaGrid(args.getInt("theta-grid", 8));
   }
   UncertainParameters up;
   up.values = pf.values;
@@ -111,6 +141,7 @@ int runDrift(const std::vector<std::string>& argv) {
     rows.push_back(row);
   }
   out["drift"] = rows;
+  if (thetas.size() == 1) out["envelope"] = envelopeDecay(r, k, thetas.front(), up, pf.omega_rad_s);
   if (args.has("json")) writeJsonFile(out, args.get("json"));
   return 0;
 }

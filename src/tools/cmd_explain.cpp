@@ -8,11 +8,12 @@
 #include "bag_input.h"
 #include "cli_args.h"
 #include "cvg_bench/core/demod/demodulator.h"
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/diagnose/explanation.h"
 #include "cvg_bench/core/demod/frequency_estimator.h"
 #include "cvg_bench/core/demod/irregular_demodulator.h"
+#include "cvg_bench/core/diagnose/explanation.h"
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_bench/report/explain_json.h"
 #include "cvg_ident_commands.h"
@@ -33,7 +34,8 @@ const char* kHelp =
     "Fits the linear model, shows what it gets wrong (residual signature against amplitude^2,\n"
     "amplitude^4, time or detuning, pattern angle), tries the candidate extensions (free decay: "
     "xi,\n"
-    "kappa, gamma_nl, cm_rate, xi_diff; forced: xi, kappa, mu, gamma_nl, xi_diff) by forward\n"
+    "kappa, gamma_nl, cm_rate, xi_diff, xi_k; forced: xi, kappa, mu, gamma_nl, xi_diff) by\n"
+    "forward "
     "selection (Wald test with the honest covariance, Bonferroni over the candidates of a step at\n"
     "level --alpha (0.01), hold-out prediction must improve), tests the final model's lack of fit\n"
     "(runs test) and prints the verdict. --json FILE ('-' = stdout) writes the explain JSON of\n"
@@ -41,7 +43,8 @@ const char* kHelp =
     "and\n"
     "(unless --no-figures) PNG figures + report.md by scripts/explain_report.py.\n"
     "INPUT: t,q1,p1,q2,p2 (free decay), omega0,q1,p1,q2,p2 (forced) or raw t,f,g (demodulated\n"
-    "first at --omega or the file's omega); or a .bag of the project's messages (--topic NAME).\n";
+    "first at --omega or the file's omega); or a .bag of the project's messages (--topic NAME).\n"
+    "example: cvg_ident explain slow.csv --mode free_decay --json explain.json\n";
 
 std::vector<std::string> splitList(const std::string& s) {
   std::vector<std::string> out;
@@ -95,12 +98,16 @@ void printSummary(const Explanation& x) {
   for (const auto& s : x.selection.steps)
     std::cout << "  + " << std::left << std::setw(9) << s.added << std::right << " sigma "
               << s.sigma << "  ratio " << s.sigma_ratio << "  F " << s.wald.f_statistic << "  p "
-              << s.wald.p_value << "  dBIC " << s.delta_bic << "  hold-out " << s.holdout_ratio
-              << "\n";
+              << s.wald.p_value << "  dIC " << s.delta_criterion << "  hold-out "
+              << s.holdout_ratio << "\n";
   for (const auto& s : x.selection.last_round)
-    std::cout << "    (not accepted: " << s.added << ", p " << s.wald.p_value << " vs "
-              << s.threshold << ", hold-out " << s.holdout_ratio << ", sigma ratio "
-              << s.sigma_ratio << ")\n";
+    std::cout << "    (not accepted: +" << s.added << ", dIC " << s.delta_criterion << ", p "
+              << s.wald.p_value << ", sigma ratio " << s.sigma_ratio << ")\n";
+  std::cout << "selection: " << x.selection.criterion_description << "\n";
+  if (!x.selection.runner_up.model.empty())
+    std::cout << "runner-up: " << x.selection.runner_up.model << ", criterion "
+              << x.selection.runner_up_delta << " worse than " << x.selection.chosen.model
+              << "\n";
   std::cout << "baseline residual signature: " << x.baseline_signature.describe(0.01) << "\n";
   std::cout << "selected: " << (x.selection.selected.empty() ? "none" : "");
   for (size_t i = 0; i < x.selection.selected.size(); ++i)
@@ -140,6 +147,8 @@ int runExplain(const std::vector<std::string>& argv) {
   RecordReadOptions read;
   read.repair_raw_timestamps = true;
   if (args.has("columns")) read.raw_columns = parseRawColumnMap(args.get("columns"));
+  if (args.has("omega")) requireOmegaInRange(id.omega_rad_s, "--omega");
+  if (args.has("json") && args.get("json") != "-") requireOutputFile(args.get("json"), "--json");
   const std::string input = args.positionals().front();
   AnyRecord rec = readRecordInput(input, read, args.get("topic"));
   std::vector<std::string> input_notes;

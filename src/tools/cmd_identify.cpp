@@ -1,20 +1,21 @@
 // cvg_ident identify: parameter estimation with confidence intervals (interfaces.md). Free decay:
 // the integral regression (2.7)-(2.8); forced sweep: the stationary regression (3.4)-(3.5); LS
-// (batch QR), RLS (2.12, corrected pairing) or Ceres (output-error refinement of the LS answer).
+// (batch QR), RLS (2.12, corrected pairing) or Ceres (output-error refinement of the LS answer),
+// all through the one pipeline of identify_pipeline.h.
 // Raw t,f,g input is demodulated first (free decay) and the output says so.
+#include <algorithm>
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
 
 #include "bag_input.h"
 #include "cli_args.h"
-#include "cvg_bench/core/estimate/ceres_refinement.h"
 #include "cvg_bench/core/demod/demodulator.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/demod/frequency_estimator.h"
-#include "cvg_bench/core/estimate/identification.h"
 #include "cvg_bench/core/demod/irregular_demodulator.h"
+#include "cvg_bench/core/estimate/identify_pipeline.h"
 #include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
 
@@ -38,6 +39,7 @@ const char* kHelp =
     "  --topic  bag topic to read (default: the one topic of a project message type)\n"
     "  --model  linear, or +-joined extensions: xi, kappa, gamma_nl, cm_rate (free decay), "
     "xi_diff,\n"
+    "           xi_k (second cubic invariant: precession proportional to r k),\n"
     "           mu (forced, needs --method ceres: mu multiplies u~ bilinearly).\n"
     "  --method ls (batch QR, default), rls (block recursive LS (2.12)), ceres (output-error fit\n"
     "           started from LS; removes the errors-in-variables bias of noisy forced sweeps).\n"
@@ -47,7 +49,8 @@ const char* kHelp =
     "structure of\n"
     "(2.7) is modelled; forced: per-point sandwich); \"parameters_paper_2_11\" the paper's "
     "(2.11).\n"
-    "Exit 1 when the data cannot identify every parameter (the report says which and why).\n";
+    "Exit 1 when the data cannot identify every parameter (the report says which and why).\n"
+    "example: cvg_ident identify sweep.csv --mode forced --model xi+mu --method ceres\n";
 
 SlowRecord demodulateRaw(const RawRecord& raw, double omega_opt, std::vector<std::string>& notes) {
   double omega = omega_opt > 0 ? omega_opt : raw.omega_rad_s;
@@ -90,8 +93,13 @@ void printTable(const Estimate& e, std::ostream& os) {
   os << "  parameter        value          +- honest CI      +- paper (2.11)\n";
   for (const auto& name : e.names) {
     const auto it = e.parameters.find(name);
+    const bool weak =
+        std::find(e.not_identified.begin(), e.not_identified.end(), name) != e.not_identified.end();
     if (it == e.parameters.end()) {
       std::snprintf(buf, sizeof(buf), "  %-10s  (not identifiable alone)\n", name.c_str());
+    } else if (weak) {
+      std::snprintf(buf, sizeof(buf), "  %-10s  not identified by this record (VIF %.3g)\n",
+                    name.c_str(), e.vif.at(name));
     } else {
       const auto pp = e.parameters_paper.find(name);
       const double paper =
@@ -108,23 +116,17 @@ void printTable(const Estimate& e, std::ostream& os) {
   }
   if (!e.derived.empty()) os << "derived (section 4):\n";
   for (const auto& kv : e.derived) {
-    std::snprintf(buf, sizeof(buf), "  %-24s  %14.8g  +- %-14.6g\n", kv.first.c_str(),
-                  kv.second.value, kv.second.ci_high - kv.second.value);
+    std::snprintf(buf, sizeof(buf), "  %-24s  %14.8g  [%.6g, %.6g]\n", kv.first.c_str(),
+                  kv.second.value, kv.second.ci_low, kv.second.ci_high);
     os << buf;
+    const auto how = e.derived_method.find(kv.first);
+    if (how != e.derived_method.end()) os << "      (" << how->second << ")\n";
   }
+  if (!e.interval_method_id.empty())
+    os << "intervals: " << e.interval_method_id << "; residual lag-1 correlation "
+       << e.residual_lag1 << " (z = " << e.residual_lag1_z << "), noise " << e.noise_model << "\n";
   if (!e.identifiability_note.empty()) os << "identifiability: " << e.identifiability_note << "\n";
   for (const auto& n : e.notes) os << "note: " << n << "\n";
-}
-
-/// Ceres options from the identify options: same confidence and angular gain; --mu is the known mu,
-/// or the starting value when the model estimates mu.
-CeresOptions ceresOptionsFor(const IdentificationOptions& opt) {
-  CeresOptions co;
-  co.confidence = opt.confidence;
-  co.angular_gain_k = opt.angular_gain_k;
-  co.known_mu = opt.mu;
-  co.mu_start = opt.mu;
-  return co;
 }
 
 }  // namespace
@@ -143,28 +145,20 @@ int runIdentify(const std::vector<std::string>& argv) {
   if (!args.has("model")) throw InputError("--model TERMS is required (e.g. linear, xi)");
   const std::string path = args.positionals().front();
   const ExperimentMode mode = parseExperimentMode(args.get("mode"));
-  const std::string method = args.get("method", "ls");
-  if (method != "ls" && method != "rls" && method != "ceres")
-    throw InputError("--method must be ls, rls or ceres, got '" + method + "'");
-  IdentificationOptions opt;
+  PipelineOptions po;
+  po.method = parseMethod(args.get("method", "ls"));
+  IdentificationOptions& opt = po.identification;
   opt.model = args.get("model");
-  opt.method = method == "rls" ? "rls" : "ls";
   opt.confidence = args.getDouble("confidence", 0.95);
   opt.omega_rad_s = args.getDouble("omega", 0.0);
   opt.angular_gain_k = args.getDouble("angular-gain", 0.4);
   opt.mu = args.getDouble("mu", 0.0);
-  const auto problems = opt.validate();
-  if (!problems.empty()) {
-    std::string m = "invalid options:";
-    for (const auto& p : problems) m += " " + p + ";";
-    throw InputError(m);
-  }
+  throwIfInvalid("invalid options", po.validate());
   RecordReadOptions ro;
   ro.repair_raw_timestamps = true;
   const AnyRecord any = readRecordInput(path, ro, args.get("topic"));
   std::vector<std::string> pre_notes;
   Estimate e;
-  const bool want_mu = ("+" + opt.model + "+").find("+mu+") != std::string::npos;
   if (mode == ExperimentMode::kFreeDecay) {
     if (any.kind == RecordKind::kForcedSweep)
       throw InputError(path +
@@ -174,8 +168,7 @@ int runIdentify(const std::vector<std::string>& argv) {
                          ? demodulateRaw(any.raw, opt.omega_rad_s, pre_notes)
                          : any.slow;
     if (rec.source.empty()) rec.source = path;
-    e = identifyFreeDecay(rec, opt);
-    if (method == "ceres") e = refineWithCeres(rec, e, ceresOptionsFor(opt));
+    e = identify(rec, po);
   } else {
     if (any.kind == RecordKind::kFreeDecay)
       throw InputError(path +
@@ -187,24 +180,7 @@ int runIdentify(const std::vector<std::string>& argv) {
                        "sweep step: run `cvg_ident demod` per step or give omega0,q1,p1,q2,p2");
     SweepRecord rec = any.sweep;
     if (rec.source.empty()) rec.source = path;
-    if (want_mu && method != "ceres")
-      throw InputError("model '" + opt.model +
-                       "' estimates mu (bilinear with u~): use --method "
-                       "ceres");
-    if (want_mu) {
-      IdentificationOptions lin = opt;
-      std::string spec;
-      const ResonatorModel with_mu(opt.model, mode);  // named: a temporary's names would dangle
-      for (const auto& t : with_mu.extensionNames())
-        if (t != "mu") spec += (spec.empty() ? "" : "+") + t;
-      lin.model = spec.empty() ? "linear" : spec;
-      e = identifyForced(rec, lin);
-      e.model = ResonatorModel(opt.model, mode).spec();
-      e.notes.push_back("Ceres start: LS with mu = " + std::to_string(opt.mu));
-    } else {
-      e = identifyForced(rec, opt);
-    }
-    if (method == "ceres") e = refineWithCeres(rec, e, ceresOptionsFor(opt));
+    e = identify(rec, po);
   }
   e.notes.insert(e.notes.begin(), pre_notes.begin(), pre_notes.end());
   std::cout << std::setprecision(8);

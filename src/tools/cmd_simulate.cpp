@@ -3,10 +3,11 @@
 #include <sstream>
 
 #include "cli_args.h"
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/simulate/experiment_runner.h"
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_preset.h"
+#include "cvg_bench/core/simulate/experiment_runner.h"
 #include "cvg_ident_commands.h"
 
 namespace cvg_bench {
@@ -31,7 +32,7 @@ const char* kHelp =
     "                    segment per settled step with columns omega0 and drive_phase_rad\n"
     "  --seed N          seed of the Gaussian measurement noise (default 1)\n"
     "  --effect N=V      set a true parameter (repeatable): gamma nu b_c b_s c_m n h_c h_s xi\n"
-    "                    kappa gamma_nl cm_rate xi_diff (model terms), u1..u4 (drive u~), mu\n"
+    "                    kappa gamma_nl cm_rate xi_diff xi_k (model terms), u1..u4 (drive u~), mu\n"
     "                    (control nonlinearity), eta (2 omega0 parametric terms of (2.1), raw\n"
     "                    forced only; 0 = off)\n"
     "  --noise STD       noise std overriding the preset's (q, or f, g with --raw); 0 = none\n"
@@ -39,7 +40,9 @@ const char* kHelp =
     "  --start R,K,THETA free decay only: start from the orbit elements (5.2) amplitude R > 0,\n"
     "                    quadrature K (|K| <= R) and pattern angle THETA [rad] instead of the\n"
     "                    drive's stationary state (e.g. to probe the axes at several angles)\n"
-    "  --out FILE        output CSV\n";
+    "  --out FILE        output CSV\n"
+    "example: cvg_ident simulate --preset quartz_cylinder --mode forced --effect kappa=2 --out "
+    "q.csv\n";
 
 }  // namespace
 
@@ -57,6 +60,8 @@ int runSimulate(const std::vector<std::string>& argv) {
     throw InputError("give exactly one of --preset NAME or --config FILE (see --help)");
   if (!args.has("mode")) throw InputError("--mode free_decay|forced is required");
   if (!args.has("out")) throw InputError("--out FILE is required");
+  if (args.has("config")) requireInputFile(args.get("config"), "--config preset file");
+  requireOutputFile(args.get("out"), "--out");
   ResonatorPreset preset = args.has("preset") ? loadShippedPreset(args.get("preset"))
                                               : loadResonatorPresetFile(args.get("config"));
   for (const auto& e : args.getAll("effect")) preset.applyEffect(e);

@@ -1,7 +1,7 @@
-// Subcommands of the offline tool (contract: ../shared/spec/interfaces.md). Each lives in its own
-// cmd_<name>.cpp, takes the arguments after the subcommand name, and returns the exit status
-// (0 success, 1 analysis failed, 2 bad usage or input). Errors may be thrown as InputError (2) or
-// AnalysisError (1); the dispatcher prints them.
+// Subcommands of the offline tool (the command-line and JSON contract; README.md, "Offline tool").
+// Each lives in its own cmd_<name>.cpp, takes the arguments after the subcommand name, and returns
+// the exit status (0 success, 1 analysis failed, 2 bad usage or input). Errors may be thrown as
+// InputError (2) or AnalysisError (1); the dispatcher prints them.
 #pragma once
 
 #include <string>

@@ -4,13 +4,15 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 
+#include "cvg_bench/core/estimate/output_error_free_decay.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
-#include "cvg_bench/core/estimate/output_error_free_decay.h"
+#include "cvg_bench/core/model/package_resources.h"
 #include "cvg_bench/core/model/stationary_solver.h"
 #include "cvg_bench/report/estimate_json.h"
 
@@ -140,7 +142,10 @@ void writeExplainReportFiles(const std::string& dir, const nlohmann::json& expla
 }
 
 bool runExplainReportScript(const std::string& dir) {
-  const std::string script = std::string(CVG_BENCH_SOURCE_DIR) + "/scripts/explain_report.py";
+  // Installed next to cvg_ident (catkin_install_python), else in the package's scripts/.
+  std::string script = executableDirectory() + "/explain_report.py";
+  if (!std::filesystem::is_regular_file(script))
+    script = findPackageResource("scripts/explain_report.py");
   const std::string cmd = "/usr/bin/python3 '" + script + "' '" + dir + "'";
   const int rc = std::system(cmd.c_str());
   if (rc != 0) {

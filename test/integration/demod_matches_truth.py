@@ -93,7 +93,7 @@ class DemodMatchesTruth(unittest.TestCase):
         fs = truth.raw_sample_rate_hz
         sigma_slow = truth.raw_noise_std * math.sqrt(4.0 * 0.5 * out_rate / fs)
         amp = max(math.sqrt(sum(c * c for c in q)) for q in qe)
-        powers = {"xi": 2, "kappa": 4, "gamma_nl": 2, "xi_diff": 2}
+        powers = {"xi": 2, "kappa": 4, "gamma_nl": 2, "xi_diff": 2, "xi_k": 2}
         eps = sum(abs(v) * amp ** powers.get(n, 0) for n, v in zip(truth.names, truth.values)) / truth.omega_rad_s
         tol = 5.0 * sigma_slow + eps * amp
         rospy.loginfo("demod vs truth: sigma_slow %.3g, eps %.3g, A %.3g -> tolerance %.3g", sigma_slow, eps, amp, tol)

@@ -16,7 +16,8 @@ import rostest
 
 from bag_player import BagPlayer
 from cvg_bench.msg import ModelEstimate
-from cvg_bench.srv import Explain, GetEstimate, Identify, PredictDrift, Reset
+from cvg_bench.srv import Explain, GetEstimate, Identify, PredictDrift
+from std_srvs.srv import Trigger
 
 
 PLAYED = []  # the bag is played once for all tests of this file
@@ -121,7 +122,7 @@ class ReplayEqualsOffline(unittest.TestCase):
         self.assertEqual(report["selected"], offline["selected"])  # same window, same answer
         self.assertEqual(report["final"]["model"], offline["final"]["model"])
 
-        reset = rospy.ServiceProxy("/cvg/identifier/reset", Reset)()
+        reset = rospy.ServiceProxy("/cvg/identifier/reset", Trigger)()
         self.assertTrue(reset.success)
         after = rospy.ServiceProxy("/cvg/get_estimate", GetEstimate)()
         self.assertFalse(after.success)

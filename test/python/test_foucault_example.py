@@ -1,14 +1,15 @@
 """Regression test of the real-data Foucault example (docs/examples/foucault.md).
 
 Runs scripts/foucault_example.py (no figures) on ../shared/data/foucault_florence_2021 relative to
-the repository root (env CVG_BENCH_ROOT) with the built tool $CVG_BENCH_ROOT/bin/cvg_ident; skipped
-when the data or the tool is missing. Tolerances are ~2x the 95 % half-widths the example reports
-(Newey-West for the direct fits, the tool's honest intervals for the ladder).
+the repository root (env CVG_BENCH_ROOT) with the built tool $CVG_BENCH_ROOT/bin/cvg_ident and
+checks every number the write-up quotes, all of which come from cvg_ident's output; skipped when
+the data or the tool is missing (the data are not in the repository). Tolerances: a few units of
+the last quoted digit for deterministic numbers (the tool is deterministic; the slack absorbs
+compiler and library differences), not the statistical intervals.
 """
 import json
 import os
 import subprocess
-import sys
 import tempfile
 import unittest
 
@@ -18,6 +19,13 @@ DATA = os.path.join(ROOT, "..", "shared", "data", "foucault_florence_2021",
                     "2021_09_17_14_57_N.csv")
 TOOL = os.path.join(ROOT, "bin", "cvg_ident")
 SCRIPT = os.path.join(ROOT, "scripts", "foucault_example.py")
+
+# The numbers quoted in docs/examples/foucault.md.
+DOC = {
+    "omega_rad_s": 2.2371955,
+    "length_m": 1.959,
+    "n_slow": 516,
+}
 
 
 def tool_works():
@@ -49,29 +57,84 @@ class FoucaultExample(unittest.TestCase):
         self.assertEqual(self.s["trimmed_samples"], 5)
         self.assertLess(self.s["max_kept_speed_px_s"], self.s["speed_limit_px_s"])
 
-    def test_reference_frequency(self):
-        # 2.2371955 +/- 8.3e-6 rad/s (1 sigma); period 2.8085 s, L = g / omega^2 = 1.959 m.
-        self.assertAlmostEqual(self.s["omega_rad_s"], 2.2371955, delta=5e-5)
-        self.assertAlmostEqual(self.s["length_m"], 1.959, delta=0.002)
+    def test_reference_frequency_and_demodulation(self):
+        self.assertAlmostEqual(self.s["omega_rad_s"], DOC["omega_rad_s"], delta=5e-6)
+        self.assertAlmostEqual(self.s["length_m"], DOC["length_m"], delta=0.002)
+        self.assertEqual(self.s["n_slow"], DOC["n_slow"])
+        self.assertAlmostEqual(self.s["r_px"]["start"], 253.5, delta=0.1)
+        self.assertAlmostEqual(self.s["r_px"]["end"], 183.1, delta=0.1)
 
-    def test_direct_precession(self):
-        d = self.s["direct"]
-        # phi = a + b t: 4.73 deg/h, 95 % half-width 0.52 (Newey-West).
-        self.assertAlmostEqual(d["phi_rate_linear_deg_h"]["value"], 4.73, delta=1.0)
-        # with the r k (Airy-type) term: 7.67 deg/h at k = 0, half-width 0.16.
-        self.assertAlmostEqual(d["phi_rate_at_k0_deg_h"]["value"], 7.67, delta=0.35)
-        self.assertLess(d["phi_rate_at_k0_deg_h"]["ci_high"],
-                        self.s["physics"]["foucault_deg_h"])
+    def test_explain_verdict_today(self):
+        # Pinned: explain's selection is being rewritten (subset scoring), so its verdict on this
+        # record may change; this records what the doc reports today (xi then cm_rate, lack of fit,
+        # xi_k significant but refused by the hold-out). Update the doc and this test together.
+        e = self.s["explain"]
+        self.assertEqual(e["selected"], ["xi", "cm_rate"])
+        self.assertTrue(e["unexplained"])
+        self.assertAlmostEqual(e["baseline"]["sigma"], 7.51, delta=0.01)
+        self.assertAlmostEqual(e["steps"][0]["sigma"], 0.714, delta=0.002)
+        self.assertAlmostEqual(e["steps"][1]["sigma"], 0.542, delta=0.002)
+        refused = [l for l in e["stdout"] if "not accepted: xi_k" in l]
+        self.assertEqual(len(refused), 1)
+        self.assertIn("hold-out 0.24", refused[0])
 
-    def test_airy_pixel_scale(self):
-        # s = sqrt((3/8) omega / (c L^2)) = 1050 +/- 14 px/m (1 sigma).
-        self.assertAlmostEqual(self.s["physics"]["pixels_per_m_from_airy"], 1050.0, delta=60.0)
+    def check(self, entry, value, low=None, high=None, rel=0.005):
+        self.assertAlmostEqual(entry["value"], value, delta=rel * abs(value))
+        if low is not None:
+            self.assertAlmostEqual(entry["ci_low"], low, delta=rel * abs(value))
+            self.assertAlmostEqual(entry["ci_high"], high, delta=rel * abs(value))
 
-    def test_ladder_xi_is_hardening(self):
-        # The amplitude-frequency law has the opposite sign of a pendulum's softening.
-        xi = self.s["ladder"]["xi"]["parameters"]["xi"]
-        self.assertAlmostEqual(xi["value"], -6.47e-7, delta=3e-8)
-        self.assertIn("xi", self.s["explain"]["selected"])
+    def test_paper_cubic_precesses_the_wrong_way(self):
+        xi = self.s["ladder"]["xi"]
+        self.check(xi["parameters"]["xi"], -6.47e-7, -6.60e-7, -6.33e-7)
+        self.check(xi["phi_rate_k0_deg_h"], 1.79, 1.46, 2.11, rel=0.02)
+        self.check(xi["phi_rate_deg_h"], 3.81, 3.51, 4.11, rel=0.01)
+        self.check(self.s["ladder"]["xi (ceres)"]["phi_rate_k0_deg_h"], 1.28, 0.84, 1.71, rel=0.03)
+
+    def test_extended_model(self):
+        ls, ce = self.s["ladder"]["xi+xi_k"], self.s["ladder"]["xi+xi_k (ceres)"]
+        self.check(ls["precession_coupling"], 9.4e-7, 4.0e-7, 14.8e-7, rel=0.01)
+        self.check(ce["precession_coupling"], 2.26e-6, 2.04e-6, 2.49e-6, rel=0.01)
+        self.check(ls["phi_rate_k0_deg_h"], 8.81, 6.51, 11.11, rel=0.005)
+        self.check(ce["phi_rate_k0_deg_h"], 12.93, 11.38, 14.47, rel=0.01)
+        self.check(ls["phi_rate_deg_h"], 5.02, 4.59, 5.44, rel=0.01)
+        self.check(ce["phi_rate_deg_h"], 4.24, 3.07, 5.41, rel=0.02)
+        self.assertAlmostEqual(self.s["ladder"]["xi (ceres)"]["sigma"], 0.714, delta=0.002)
+        self.assertAlmostEqual(ce["sigma"], 0.529, delta=0.002)
+        self.assertAlmostEqual(self.s["physics"]["sigma_gain_over_paper_cubic_ceres"], 1.35,
+                               delta=0.01)
+        self.assertAlmostEqual(self.s["physics"]["sigma_gain_over_paper_cubic"], 1.0002,
+                               delta=0.0005)
+        self.assertAlmostEqual(self.s["physics"]["pixels_per_m_from_coupling"], 967, delta=5)
+        self.assertAlmostEqual(self.s["physics"]["foucault_deg_h"], 10.40, delta=0.005)
+        # The LS swing rate's interval contains Foucault's 10.40 deg/h; the Ceres one does not.
+        self.assertLess(ls["phi_rate_k0_deg_h"]["ci_low"], 10.40)
+        self.assertGreater(ls["phi_rate_k0_deg_h"]["ci_high"], 10.40)
+        self.assertGreater(ce["phi_rate_k0_deg_h"]["ci_low"], 10.40)
+
+    def test_quality_factor(self):
+        self.assertAlmostEqual(self.s["Q_envelope_record"], 4970, delta=10)
+        ce = self.s["ladder"]["xi+xi_k (ceres)"]["envelope"]
+        ls = self.s["ladder"]["xi+xi_k"]["envelope"]
+        for e, q, lo, hi in ((ce, 4874, 4750, 5004), (ls, 4481, 4393, 4572)):
+            self.assertAlmostEqual(e["Q"], q, delta=20)
+            self.assertAlmostEqual(e["Q_ci_low"], lo, delta=20)
+            self.assertAlmostEqual(e["Q_ci_high"], hi, delta=20)
+        gamma = self.s["ladder"]["xi+xi_k"]["parameters"]["gamma"]
+        self.assertLess(gamma["ci_low"], 0.0)  # not identified: W/gamma means nothing
+        self.assertAlmostEqual(self.s["ladder"]["xi+xi_k"]["Q_from_gamma"], 8917, delta=50)
+        self.assertAlmostEqual(self.s["ladder"]["linear"]["Q_from_gamma"], 1553, delta=10)
+
+    def test_not_separable(self):
+        c = self.s["ladder"]["xi+xi_k"]["max_linear_corr"]
+        self.assertEqual(sorted(c["pair"]), ["h_c", "n"])
+        self.assertGreater(abs(c["corr"]), 0.9998)
+        p = self.s["ladder"]["xi+xi_k"]["parameters"]
+        self.assertAlmostEqual(p["n"]["value"], -0.042, delta=0.001)
+        self.assertAlmostEqual(p["h_c"]["value"], -0.040, delta=0.001)
+        self.assertAlmostEqual(p["nu"]["value"], -0.0035, delta=0.0001)
+        self.assertAlmostEqual(self.s["ladder"]["xi+xi_k (ceres)"]["parameters"]["n"]["value"],
+                               -0.027, delta=0.001)
 
 
 if __name__ == "__main__":

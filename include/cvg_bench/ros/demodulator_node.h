@@ -10,6 +10,7 @@
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
+#include <std_srvs/Trigger.h>
 
 #include <map>
 #include <memory>
@@ -17,7 +18,6 @@
 #include <vector>
 
 #include "cvg_bench/RawSampleBatch.h"
-#include "cvg_bench/Reset.h"
 #include "cvg_bench/core/demod/demodulator.h"
 #include "cvg_bench/ros/demodulator_node_options.h"
 
@@ -30,7 +30,7 @@ class DemodulatorNode {
 
  private:
   void onRaw(const RawSampleBatch::ConstPtr& msg);
-  bool onReset(Reset::Request& req, Reset::Response& res);
+  bool onReset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   void resetState(const std::string& why);
   /// (Re)builds the core demodulator for reference W and rate; InputError when they do not suit
   /// the filter settings.

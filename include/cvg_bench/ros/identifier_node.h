@@ -10,6 +10,7 @@
 #pragma once
 
 #include <ros/ros.h>
+#include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <deque>
@@ -20,10 +21,10 @@
 #include "cvg_bench/GetEstimate.h"
 #include "cvg_bench/Identify.h"
 #include "cvg_bench/PredictDrift.h"
-#include "cvg_bench/Reset.h"
 #include "cvg_bench/SlowState.h"
 #include "cvg_bench/SweepPoint.h"
 #include "cvg_bench/core/estimate/estimate.h"
+#include "cvg_bench/core/estimate/identify_pipeline.h"
 #include "cvg_bench/core/io/records.h"
 #include "cvg_bench/ros/identifier_node_options.h"
 #include "cvg_bench/ros/streaming_free_decay_rls.h"
@@ -42,11 +43,15 @@ class IdentifierNode {
   bool onIdentify(Identify::Request& req, Identify::Response& res);
   bool onGetEstimate(GetEstimate::Request& req, GetEstimate::Response& res);
   bool onPredictDrift(PredictDrift::Request& req, PredictDrift::Response& res);
-  bool onReset(Reset::Request& req, Reset::Response& res);
+  bool onReset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool onExplain(Explain::Request& req, Explain::Response& res);
 
-  /// Batch identification over the buffer with these options; stores and publishes the result.
-  /// Throws InputError / AnalysisError (callers turn them into success = false).
+  /// Identification of the buffer by the pipeline (identify_pipeline.h, any method); stores and
+  /// publishes the result. Throws InputError / AnalysisError (callers turn them into success =
+  /// false).
+  void identifyNow(const PipelineOptions& options);
+  /// The same by batch LS (periodic and end-of-data runs; in `rls` mode the recursive estimate
+  /// streams already).
   void identifyNow(const IdentificationOptions& options);
   void clearData(const std::string& why);
   /// The buffered window as a core record (t from the first buffered stamp).

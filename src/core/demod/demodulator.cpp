@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "cvg_bench/core/demod/demodulator_noise.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/estimate/internal/simd_vector4.h"
+#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {
@@ -138,13 +138,7 @@ std::vector<std::string> DemodulatorOptions::validate() const {
 }
 
 Demodulator::Demodulator(const DemodulatorOptions& options) : options_(options) {
-  const auto problems = options.validate();
-  if (!problems.empty()) {
-    std::ostringstream m;
-    m << "demodulator options:";
-    for (const auto& p : problems) m << " " << p << ";";
-    throw InputError(m.str());
-  }
+  throwIfInvalid("demodulator options", options.validate());
   const int m = static_cast<int>(std::round(options.sample_rate_hz / options.output_rate_hz));
   const double out = options.sample_rate_hz / m;
   passband_hz_ = options.passband_hz > 0.0 ? options.passband_hz : 0.2 * out;
@@ -275,6 +269,10 @@ void Demodulator::push(const double* t, const double* f, const double* g, size_t
         break;
       case RunStart::kRestartGap:
         restart("gap before t = " + describe(t[run.begin]) + " s: filter restarted");
+        break;
+      case RunStart::kRestartBad:
+        restart("out-of-range sample dropped before t = " + describe(t[run.begin]) +
+                " s: filter state cleared");
         break;
       case RunStart::kResetBackward:
         restart("time jumped back to t = " + describe(t[run.begin]) + " s: demodulator reset");

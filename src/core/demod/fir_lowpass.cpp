@@ -5,8 +5,8 @@
 #include <cstring>
 #include <sstream>
 
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/estimate/internal/simd_vector4.h"
+#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {
@@ -144,13 +144,7 @@ LowpassCheck checkLowpass(const std::vector<double>& taps, const LowpassSpec& s)
 }
 
 std::vector<double> designKaiserLowpass(const LowpassSpec& spec) {
-  const auto problems = spec.validate();
-  if (!problems.empty()) {
-    std::ostringstream m;
-    m << "low-pass design:";
-    for (const auto& p : problems) m << " " << p << ";";
-    throw InputError(m.str());
-  }
+  throwIfInvalid("low-pass design", spec.validate());
   // 1 % margin covers the grid's sampling of the lobe peaks.
   const double delta = 0.99 * std::pow(10.0, -spec.attenuation_db / 20.0);
   size_t n = kaiserLength(spec);

@@ -112,16 +112,11 @@ std::vector<std::string> FrequencyEstimatorOptions::validate() const {
   return p;
 }
 
-FrequencyEstimate estimateFrequency(const std::vector<double>& t, const std::vector<double>& f,
-                                    const std::vector<double>& g,
-                                    const FrequencyEstimatorOptions& o) {
-  const auto problems = o.validate();
-  if (!problems.empty()) {
-    std::ostringstream m;
-    m << "frequency estimator options:";
-    for (const auto& p : problems) m << " " << p << ";";
-    throw InputError(m.str());
-  }
+namespace {
+
+/// Throws InputError unless t, f, g are finite, of one length >= 16, with increasing times.
+void requireSignal(const std::vector<double>& t, const std::vector<double>& f,
+                   const std::vector<double>& g) {
   const size_t n = t.size();
   if (f.size() != n || g.size() != n) throw InputError("frequency estimation: sizes differ");
   if (n < 16) throw InputError("frequency estimation needs at least 16 samples");
@@ -132,20 +127,49 @@ FrequencyEstimate estimateFrequency(const std::vector<double>& t, const std::vec
       throw InputError("frequency estimation: timestamps not increasing at sample " +
                        std::to_string(i));
   }
+}
+
+/// The record's time scales and the frequency band searched [Hz].
+struct SearchBand {
+  double dt = 0.0;    ///< median sampling interval [s]
+  double span = 0.0;  ///< record length [s]
+  double fmin = 0.0, fmax = 0.0;
+};
+
+SearchBand searchBand(const std::vector<double>& t, const FrequencyEstimatorOptions& o) {
+  const size_t n = t.size();
   std::vector<double> d(n - 1);
   for (size_t i = 1; i < n; ++i) d[i - 1] = t[i] - t[i - 1];
   std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  const double dt = d[d.size() / 2];
-  const double span = t.back() - t.front();
-  const double fmin = o.min_hz > 0.0 ? o.min_hz : 3.0 / span;
-  const double fmax = o.max_hz > 0.0 ? o.max_hz : 0.5 / dt;
-  if (!(fmax > fmin)) throw InputError("frequency estimation: record too short for the band");
+  SearchBand b;
+  b.dt = d[d.size() / 2];
+  b.span = t.back() - t.front();
+  b.fmin = o.min_hz > 0.0 ? o.min_hz : 3.0 / b.span;
+  b.fmax = o.max_hz > 0.0 ? o.max_hz : 0.5 / b.dt;
+  if (!(b.fmax > b.fmin)) throw InputError("frequency estimation: record too short for the band");
+  return b;
+}
 
-  // 1. Coarse FFT peak on a uniform grid over the first segment.
-  const size_t grid_n = static_cast<size_t>(std::floor(span / dt)) + 1;
-  const size_t seg_n = std::min(grid_n, size_t(o.max_fft_samples / o.oversampling));
+struct CoarsePeak {
+  double omega_rad_s = 0.0;
+  size_t nfft = 0;   ///< FFT length (zero-padded)
+  size_t seg_n = 0;  ///< samples of the first segment transformed
+};
+
+/// Step 1: the FFT peak of f and g, resampled linearly onto a uniform grid over the first
+/// segment, refined by a parabola through the log powers of the peak bin and its neighbours.
+CoarsePeak coarsePeak(const std::vector<double>& t, const std::vector<double>& f,
+                      const std::vector<double>& g, const SearchBand& band,
+                      const FrequencyEstimatorOptions& o) {
+  const size_t n = t.size();
+  const double dt = band.dt;
+  const size_t grid_n = static_cast<size_t>(std::floor(band.span / dt)) + 1;
+  CoarsePeak peak;
+  peak.seg_n = std::min(grid_n, size_t(o.max_fft_samples / o.oversampling));
+  const size_t seg_n = peak.seg_n;
   size_t nfft = 1;
   while (nfft < seg_n * size_t(o.oversampling)) nfft <<= 1;
+  peak.nfft = nfft;
   std::vector<double> uf(nfft, 0.0), ug(nfft, 0.0);
   double mf = 0.0, mg = 0.0;
   for (size_t k = 0, i = 0; k < seg_n; ++k) {
@@ -166,8 +190,8 @@ FrequencyEstimate estimateFrequency(const std::vector<double>& t, const std::vec
   fft.fwd(ff, uf);
   fft.fwd(fg, ug);
   const double df = 1.0 / (nfft * dt);
-  const size_t k_lo = std::max<size_t>(1, static_cast<size_t>(std::ceil(fmin / df)));
-  const size_t k_hi = std::min(nfft / 2 - 1, static_cast<size_t>(std::floor(fmax / df)));
+  const size_t k_lo = std::max<size_t>(1, static_cast<size_t>(std::ceil(band.fmin / df)));
+  const size_t k_hi = std::min(nfft / 2 - 1, static_cast<size_t>(std::floor(band.fmax / df)));
   if (k_hi <= k_lo) throw InputError("frequency estimation: no FFT bin in the search band");
   auto power = [&](size_t k) { return std::norm(ff[k]) + std::norm(fg[k]); };
   size_t kp = k_lo;
@@ -180,31 +204,54 @@ FrequencyEstimate estimateFrequency(const std::vector<double>& t, const std::vec
     const double den = lm - 2.0 * l0 + lp;
     if (den < 0.0) shift = std::clamp(0.5 * (lm - lp) / den, -0.5, 0.5);
   }
-  FrequencyEstimate est;
-  est.coarse_rad_s = 2.0 * M_PI * (kp + shift) * df;
-  est.n_samples = n;
+  peak.omega_rad_s = 2.0 * M_PI * (kp + shift) * df;
+  return peak;
+}
 
-  // 2. Gauss-Newton over spans growing 4x from the coarse segment to the whole record.
-  double w = est.coarse_rad_s;
-  double fit_span = seg_n * dt;
+/// Step 2: Gauss-Newton over spans growing 4x from the coarse segment to the whole record
+/// (strided to kMaxFitSamples); *stages counts the spans fitted.
+SineFit refineFrequency(const std::vector<double>& t, const std::vector<double>& f,
+                        const std::vector<double>& g, const SearchBand& band,
+                        const CoarsePeak& peak, const FrequencyEstimatorOptions& o, int* stages) {
+  double w = peak.omega_rad_s;
+  double fit_span = peak.seg_n * band.dt;
   SineFit fit;
-  int stages = 0;
+  *stages = 0;
   for (;;) {
-    fit_span = std::min(fit_span, span);
+    fit_span = std::min(fit_span, band.span);
     std::vector<size_t> idx;
     const double t_end = t.front() + fit_span;
     const size_t count = std::upper_bound(t.begin(), t.end(), t_end) - t.begin();
     const size_t stride = std::max<size_t>(1, (count + kMaxFitSamples - 1) / kMaxFitSamples);
     for (size_t i = 0; i < count; i += stride) idx.push_back(i);
     fit = fitSines(t, f, g, idx, w, o.max_iterations);
-    ++stages;
-    if (!std::isfinite(fit.w) || fit.w < 2.0 * M_PI * fmin * 0.5 || fit.w > 2.0 * M_PI * fmax * 2)
+    ++*stages;
+    if (!std::isfinite(fit.w) || fit.w < 2.0 * M_PI * band.fmin * 0.5 ||
+        fit.w > 2.0 * M_PI * band.fmax * 2)
       throw AnalysisError("frequency estimation diverged (coarse peak " +
-                          std::to_string(est.coarse_rad_s) + " rad/s)");
+                          std::to_string(peak.omega_rad_s) + " rad/s)");
     w = fit.w;
-    if (fit_span >= span) break;
+    if (fit_span >= band.span) break;
     fit_span *= 4.0;
   }
+  return fit;
+}
+
+}  // namespace
+
+FrequencyEstimate estimateFrequency(const std::vector<double>& t, const std::vector<double>& f,
+                                    const std::vector<double>& g,
+                                    const FrequencyEstimatorOptions& o) {
+  throwIfInvalid("frequency estimator options", o.validate());
+  requireSignal(t, f, g);
+  const SearchBand band = searchBand(t, o);
+  const CoarsePeak peak = coarsePeak(t, f, g, band, o);
+  int stages = 0;
+  const SineFit fit = refineFrequency(t, f, g, band, peak, o, &stages);
+
+  FrequencyEstimate est;
+  est.coarse_rad_s = peak.omega_rad_s;
+  est.n_samples = t.size();
   est.omega_rad_s = fit.w;
   est.std_rad_s = fit.std_w;
   est.residual_rms = fit.sigma;
@@ -212,7 +259,7 @@ FrequencyEstimate estimateFrequency(const std::vector<double>& t, const std::vec
                             fit.theta[4] * fit.theta[4] + fit.theta[5] * fit.theta[5]);
   std::ostringstream m;
   m.precision(12);
-  m << "estimated from the data: FFT peak of f,g (" << nfft << " points, " << seg_n
+  m << "estimated from the data: FFT peak of f,g (" << peak.nfft << " points, " << peak.seg_n
     << " samples) at " << est.coarse_rad_s << " rad/s, refined by nonlinear least squares of "
     << "common-frequency sinusoids in " << stages << " stage(s) to " << est.omega_rad_s << " +- "
     << est.std_rad_s << " rad/s (1 sigma)";

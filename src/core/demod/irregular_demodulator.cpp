@@ -27,40 +27,102 @@ std::vector<std::string> IrregularDemodulatorOptions::validate() const {
   return p;
 }
 
+namespace {
+
+/// The valid samples: non-finite ones and any not strictly after the last kept one are dropped
+/// (and counted).
+struct ScreenedSamples {
+  std::vector<double> t, f, g;
+};
+
+ScreenedSamples screenSamples(const RawRecord& raw, SampleCounters* counters) {
+  ScreenedSamples out;
+  out.t.reserve(raw.size());
+  for (size_t i = 0; i < raw.size(); ++i) {
+    if (!std::isfinite(raw.t_s[i]) || !std::isfinite(raw.f[i]) || !std::isfinite(raw.g[i])) {
+      ++counters->non_finite;
+      continue;
+    }
+    if (!out.t.empty() && raw.t_s[i] <= out.t.back()) {
+      ++(raw.t_s[i] == out.t.back() ? counters->duplicate_timestamp : counters->non_monotonic);
+      continue;
+    }
+    out.t.push_back(raw.t_s[i]);
+    out.f.push_back(raw.f[i]);
+    out.g.push_back(raw.g[i]);
+  }
+  counters->accepted = out.t.size();
+  return out;
+}
+
+int numColumns(const IrregularDemodulatorOptions& o) {
+  return 2 + (o.fit_envelope_slope ? 2 : 0) + (o.fit_offset ? 1 : 0) + (o.fit_offset_slope ? 1 : 0);
+}
+
+/// Design matrix and right-hand sides (f, g) of the window of n samples from i0 centred on tc:
+/// columns cos, sin of the reference phase, then the optional envelope slopes, offset and offset
+/// slope (tau = (t - tc) / half, normalized for conditioning).
+void windowSystem(const ScreenedSamples& x, size_t i0, long n, double tc, double half,
+                  const IrregularDemodulatorOptions& o, Eigen::MatrixXd* a, Eigen::MatrixXd* rhs) {
+  a->resize(n, numColumns(o));
+  rhs->resize(n, 2);
+  for (long r = 0; r < n; ++r) {
+    const double ti = x.t[i0 + r], tau = (ti - tc) / half;
+    const double ph = referencePhase(o.omega_rad_s, ti);
+    const double c = std::cos(ph), s = std::sin(ph);
+    int j = 0;
+    (*a)(r, j++) = c;
+    (*a)(r, j++) = s;
+    if (o.fit_envelope_slope) {
+      (*a)(r, j++) = tau * c;
+      (*a)(r, j++) = tau * s;
+    }
+    if (o.fit_offset) (*a)(r, j++) = 1.0;
+    if (o.fit_offset_slope) (*a)(r, j++) = tau;
+    (*rhs)(r, 0) = x.f[i0 + r];
+    (*rhs)(r, 1) = x.g[i0 + r];
+  }
+}
+
+/// Solves one window by QR; appends q = (a_f, b_f, a_g, b_g) and its standard errors at tc.
+/// False when the window is rank-deficient.
+bool solveWindow(const Eigen::MatrixXd& a, const Eigen::MatrixXd& rhs, double tc,
+                 IrregularDemodResult* res) {
+  const int cols = static_cast<int>(a.cols());
+  const long n = a.rows();
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
+  if (qr.rank() < cols || n <= cols) return false;
+  const Eigen::MatrixXd x = qr.solve(rhs);
+  const Eigen::Array2d rss = (a * x - rhs).colwise().squaredNorm().array();
+  const Eigen::Array2d var = rss / double(n - cols);
+  // diag((A^T A)^-1) for the first two columns: A P = Q R -> (A^T A)^-1 = P R^-1 R^-T P^T.
+  const Eigen::MatrixXd r = qr.matrixR().topLeftCorner(cols, cols).triangularView<Eigen::Upper>();
+  const Eigen::MatrixXd rinv =
+      r.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(cols, cols));
+  const Eigen::MatrixXd cov_perm = rinv * rinv.transpose();
+  const Eigen::MatrixXd cov = qr.colsPermutation() * cov_perm * qr.colsPermutation().transpose();
+  res->record.t_s.push_back(tc);
+  res->record.q.emplace_back(x(0, 0), x(1, 0), x(0, 1), x(1, 1));
+  res->std_error.emplace_back(std::sqrt(var[0] * cov(0, 0)), std::sqrt(var[0] * cov(1, 1)),
+                              std::sqrt(var[1] * cov(0, 0)), std::sqrt(var[1] * cov(1, 1)));
+  res->n_samples.push_back(static_cast<int>(n));
+  return true;
+}
+
+}  // namespace
+
 IrregularDemodResult demodulateIrregular(const RawRecord& raw,
                                          const IrregularDemodulatorOptions& o) {
-  const auto problems = o.validate();
-  if (!problems.empty()) {
-    std::ostringstream m;
-    m << "irregular demodulator options:";
-    for (const auto& p : problems) m << " " << p << ";";
-    throw InputError(m.str());
-  }
+  throwIfInvalid("irregular demodulator options", o.validate());
   if (raw.t_s.size() != raw.f.size() || raw.t_s.size() != raw.g.size())
     throw InputError("raw record: t, f, g sizes differ");
   IrregularDemodResult res;
-  // Screening: drop non-finite samples and any sample not strictly after the last kept one.
-  std::vector<double> t, f, g;
-  t.reserve(raw.size());
-  for (size_t i = 0; i < raw.size(); ++i) {
-    if (!std::isfinite(raw.t_s[i]) || !std::isfinite(raw.f[i]) || !std::isfinite(raw.g[i])) {
-      ++res.counters.non_finite;
-      continue;
-    }
-    if (!t.empty() && raw.t_s[i] <= t.back()) {
-      ++(raw.t_s[i] == t.back() ? res.counters.duplicate_timestamp : res.counters.non_monotonic);
-      continue;
-    }
-    t.push_back(raw.t_s[i]);
-    f.push_back(raw.f[i]);
-    g.push_back(raw.g[i]);
-  }
-  res.counters.accepted = t.size();
+  const ScreenedSamples x = screenSamples(raw, &res.counters);
+  const std::vector<double>& t = x.t;
   const double window = o.window_s > 0.0 ? o.window_s : 2.0 / o.output_rate_hz;
-  const int cols =
-      2 + (o.fit_envelope_slope ? 2 : 0) + (o.fit_offset ? 1 : 0) + (o.fit_offset_slope ? 1 : 0);
-  const int min_samples = o.min_samples > 0 ? o.min_samples : cols + 4;
+  const int min_samples = o.min_samples > 0 ? o.min_samples : numColumns(o) + 4;
   if (t.size() < 2) throw InputError("raw record " + raw.source + ": fewer than 2 valid samples");
+  // One window per output time k / output_rate that fits inside the record.
   const double step = 1.0 / o.output_rate_hz, half = 0.5 * window;
   const long k0 = static_cast<long>(std::ceil((t.front() + half) / step - 1e-9));
   const long k1 = static_cast<long>(std::floor((t.back() - half) / step + 1e-9));
@@ -75,45 +137,11 @@ IrregularDemodResult demodulateIrregular(const RawRecord& raw,
       res.skipped_window_times.push_back(tc);
       continue;
     }
-    a.resize(n, cols);
-    rhs.resize(n, 2);
-    const size_t i0 = lo - t.begin();
-    for (long r = 0; r < n; ++r) {
-      const double ti = t[i0 + r], tau = (ti - tc) / half;  // tau normalized for conditioning
-      const double ph = referencePhase(o.omega_rad_s, ti);
-      const double c = std::cos(ph), s = std::sin(ph);
-      int j = 0;
-      a(r, j++) = c;
-      a(r, j++) = s;
-      if (o.fit_envelope_slope) {
-        a(r, j++) = tau * c;
-        a(r, j++) = tau * s;
-      }
-      if (o.fit_offset) a(r, j++) = 1.0;
-      if (o.fit_offset_slope) a(r, j++) = tau;
-      rhs(r, 0) = f[i0 + r];
-      rhs(r, 1) = g[i0 + r];
-    }
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
-    if (qr.rank() < cols || n <= cols) {
+    windowSystem(x, lo - t.begin(), n, tc, half, o, &a, &rhs);
+    if (!solveWindow(a, rhs, tc, &res)) {
       ++res.n_rank_deficient;
       res.skipped_window_times.push_back(tc);
-      continue;
     }
-    const Eigen::MatrixXd x = qr.solve(rhs);
-    const Eigen::Array2d rss = (a * x - rhs).colwise().squaredNorm().array();
-    const Eigen::Array2d var = rss / double(n - cols);
-    // diag((A^T A)^-1) for the first two columns: A P = Q R -> (A^T A)^-1 = P R^-1 R^-T P^T.
-    const Eigen::MatrixXd r = qr.matrixR().topLeftCorner(cols, cols).triangularView<Eigen::Upper>();
-    const Eigen::MatrixXd rinv =
-        r.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(cols, cols));
-    const Eigen::MatrixXd cov_perm = rinv * rinv.transpose();
-    const Eigen::MatrixXd cov = qr.colsPermutation() * cov_perm * qr.colsPermutation().transpose();
-    res.record.t_s.push_back(tc);
-    res.record.q.emplace_back(x(0, 0), x(1, 0), x(0, 1), x(1, 1));
-    res.std_error.emplace_back(std::sqrt(var[0] * cov(0, 0)), std::sqrt(var[0] * cov(1, 1)),
-                               std::sqrt(var[1] * cov(0, 0)), std::sqrt(var[1] * cov(1, 1)));
-    res.n_samples.push_back(static_cast<int>(n));
   }
   if (res.record.t_s.empty()) {
     std::ostringstream m;

@@ -20,6 +20,11 @@ const std::vector<CandidateExtension>& allCandidates() {
        "phase-rate (tangential) residual growing linearly with time", false},
       {"xi_diff", "xi_diff", "unequal cubic stiffness of the two axes", "1/(s amp^2)",
        "amplitude-dependent residual that depends on the pattern angle theta", false},
+      {"xi_k", "xi_k", "second cubic invariant (angular-momentum coupling, e.g. Airy precession)",
+       "1/(s amp^2)",
+       "pattern-angle drift proportional to r k (the ellipse's area) that xi's frequency law "
+       "cannot carry",
+       false},
   };
   return c;
 }
@@ -27,6 +32,9 @@ const std::vector<CandidateExtension>& allCandidates() {
 bool applies(const std::string& name, ExperimentMode mode) {
   if (name == "mu") return mode == ExperimentMode::kForced;
   if (name == "cm_rate") return mode == ExperimentMode::kFreeDecay;
+  // xi_k is offered for free decay, where the orbit's quadrature k evolves; in forced sweeps it
+  // is a term of `identify --model` but not yet validated as a candidate.
+  if (name == "xi_k") return mode == ExperimentMode::kFreeDecay;
   return true;
 }
 

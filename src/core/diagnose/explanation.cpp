@@ -117,26 +117,20 @@ std::string verdict(const Explanation& x, ExperimentMode mode, const ExplainOpti
   std::ostringstream o;
   const SelectionResult& sel = x.selection;
   if (sel.selected.empty()) {
-    o << "No candidate extension improves the linear model significantly";
-    const SelectionStep* best = nullptr;
-    for (const auto& s : sel.last_round)
-      if (!best || s.wald.p_value < best->wald.p_value) best = &s;
-    if (best)
-      o << " (best: " << best->added << ", " << pText(best->wald.p_value) << " against "
-        << num(best->threshold, 2) << ", hold-out ratio " << num(best->holdout_ratio) << ")";
-    o << ".";
+    o << "No subset of the candidate extensions improves the linear model significantly.";
   } else {
     double sigma = sel.baseline.sigma;
     bool first = true;
     for (const auto& s : sel.steps) {
-      if (std::find(sel.selected.begin(), sel.selected.end(), s.added) == sel.selected.end())
-        continue;
       o << (first ? "" : " Then ")
         << describeStep(s, findCandidateExtension(s.added, mode), x.finalEstimate(), sigma) << ".";
       sigma = s.sigma;
       first = false;
     }
   }
+  if (!sel.runner_up.model.empty() && std::isfinite(sel.runner_up_delta))
+    o << " Runner-up: " << sel.runner_up.model << ", criterion " << num(sel.runner_up_delta, 3)
+      << (sel.runner_up_delta >= 0 ? " worse" : " better but not confirmed by the hold-out") << ".";
   if (x.unexplained) {
     o << " Systematic structure remains that no candidate removes: "
       << x.final_signature.describe(options.lack_of_fit_alpha) << "; lack of fit "
@@ -157,18 +151,48 @@ std::vector<CandidateExtension> chosenCandidates(ExperimentMode mode,
   return out;
 }
 
+/// The blocks with their residuals whitened by the noise model (projections recomputed).
+std::vector<BlockResidual> whitenBlocks(const std::vector<BlockResidual>& blocks,
+                                        const ResidualNoiseModel& model) {
+  if (model.ar.empty()) return blocks;
+  Eigen::VectorXd e(4 * blocks.size());
+  std::vector<Eigen::Vector4d> q(blocks.size());
+  std::vector<double> abscissa(blocks.size()), detuning(blocks.size());
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    e.segment<4>(4 * i) = blocks[i].e;
+    q[i] = blocks[i].q;
+    abscissa[i] = blocks[i].abscissa;
+    detuning[i] = blocks[i].detuning;
+  }
+  return blockResiduals(whiten(e, 4, model), q, abscissa, detuning);
+}
+
 Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
                         const ExplainOptions& options) {
   Explanation x;
   x.mode = mode;
   const auto candidates = chosenCandidates(mode, options);
-  x.selection = forwardSelect(fitter, candidates, options.selection, &x.notes);
+  x.selection = selectExtensions(fitter, candidates, options.selection, &x.notes);
   const int stride = mode == ExperimentMode::kForced ? 1 : options.signature_stride;
   x.baseline_blocks = fitter.blocks(x.selection.baseline);
   x.final_blocks = fitter.blocks(x.selection.final_fit);
   x.baseline_signature = residualSignature(x.baseline_blocks, mode, stride, options.signature_bins);
-  x.final_signature = residualSignature(x.final_blocks, mode, stride, options.signature_bins);
-  x.lack_of_fit = lackOfFit(mode, fitter.adequacyResiduals(x.selection.final_fit));
+  // Adequacy under the noise model: the record's known correlation, else AR(1) of the residuals
+  // (residual_noise_model.h); the runs test and the final signature see whitened residuals.
+  const std::vector<BlockResidual> adequacy = fitter.adequacyResiduals(x.selection.final_fit);
+  const std::vector<double> known = fitter.knownNoiseCorrelation();
+  if (!known.empty()) {
+    x.noise_model = noiseModelFromCorrelation(known);
+  } else {
+    Eigen::VectorXd e(4 * adequacy.size());
+    for (size_t i = 0; i < adequacy.size(); ++i) e.segment<4>(4 * i) = adequacy[i].e;
+    x.noise_model = noiseModelFromResiduals(e, 4);
+  }
+  x.final_signature = residualSignature(whitenBlocks(x.final_blocks, x.noise_model), mode, stride,
+                                        options.signature_bins);
+  x.lack_of_fit = lackOfFit(mode, whitenBlocks(adequacy, x.noise_model));
+  x.lack_of_fit.noise_model = x.noise_model.description;
+  x.lack_of_fit.p_value_unwhitened = lackOfFit(mode, adequacy).p_value;
   const ResidualSignature& fs = x.final_signature;
   bool structured = false;
   for (const auto& e : fs.entries)
@@ -176,6 +200,7 @@ Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
       structured = true;
   x.unexplained = x.lack_of_fit.p_value < options.lack_of_fit_alpha || structured;
   x.notes.push_back("hold-out: " + x.selection.holdout_description);
+  x.notes.push_back("adequacy noise model: " + x.noise_model.description);
   x.cause = verdict(x, mode, options);
   return x;
 }

@@ -5,17 +5,13 @@
 #include <cmath>
 #include <limits>
 
+#include "cvg_bench/core/demod/demodulator_noise.h"
+#include "cvg_bench/core/estimate/identify_pipeline.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {
-
-std::string modelSpecOf(const std::vector<std::string>& extensions) {
-  std::string s = "linear";
-  for (const auto& e : extensions) s += "+" + e;
-  return s;
-}
 
 std::vector<std::string> NestedFitterOptions::validate() const {
   std::vector<std::string> p = identification.validate();
@@ -42,35 +38,40 @@ NestedFit fitSystem(const StackedSystem& sys, const IdentificationOptions& o,
   return f;
 }
 
-/// identifyForced (per-point cluster sandwich intervals) plus the equation residuals.
+/// Forced LS (per-point cluster sandwich intervals) plus the equation residuals.
 NestedFit fitRecord(const SweepRecord& record, const IdentificationOptions& o,
                     const std::vector<std::string>& extensions) {
   const StackedSystem sys = buildForcedSystem({record}, o);
   NestedFit f = fitSystem(sys, o, extensions);
-  f.estimate = identifyForced(record, o);
+  PipelineOptions ls;
+  ls.method = Method::kLs;
+  ls.identification = o;
+  f.estimate = identify(record, ls);
   f.residuals = equationResiduals(sys, f.estimate.values);
   f.rss = f.residuals.squaredNorm();
   f.sigma = f.estimate.sigma;
   return f;
 }
 
-void throwIfInvalid(const NestedFitterOptions& options) {
-  const auto problems = options.validate();
-  if (problems.empty()) return;
-  std::string msg = "invalid explain fitting options:";
-  for (const auto& p : problems) msg += " " + p + ";";
-  throw InputError(msg);
-}
-
 class FreeDecayFitter : public NestedModelFitter {
  public:
   FreeDecayFitter(const SlowRecord& record, const NestedFitterOptions& options)
       : record_(record), options_(options) {
-    throwIfInvalid(options);
+    throwIfInvalid("invalid explain fitting options", options.validate());
   }
 
   NestedFit fit(const std::vector<std::string>& extensions) const override {
     return fitOn(record_, extensions);
+  }
+
+  NestedFit fitEquationError(const std::vector<std::string>& extensions) const override {
+    IdentificationOptions o = options_.identification;
+    o.model = modelSpecOf(extensions);
+    return fitSystem(buildFreeDecaySystem({record_}, o), o, extensions);
+  }
+  bool refinesByOutputError() const override { return true; }
+  std::vector<double> knownNoiseCorrelation() const override {
+    return noiseCorrelationFromMetadata(record_.metadata);
   }
 
   double holdoutRms(const std::vector<std::string>& extensions) const override {
@@ -80,7 +81,7 @@ class FreeDecayFitter : public NestedModelFitter {
     train.t_s.assign(record_.t_s.begin(), record_.t_s.begin() + split);
     train.q.assign(record_.q.begin(), record_.q.begin() + split);
     const Estimate e = fitOn(train, extensions).estimate;
-    const ResonatorModel model(modelSpecOf(extensions), ExperimentMode::kFreeDecay);
+    const ResonatorModel model(extensions, ExperimentMode::kFreeDecay);
     ParameterValues values;
     for (size_t i = 0; i < e.names.size(); ++i) values[e.names[i]] = e.values[i];
     std::vector<Eigen::Vector4d> trajectory;
@@ -159,28 +160,23 @@ class FreeDecayFitter : public NestedModelFitter {
   /// output-error residuals are the measurement noise itself, so the Wald test on its covariance is
   /// honest. The equation residuals (for the signature) are those of (2.8) at the refined z.
   NestedFit fitOn(const SlowRecord& record, const std::vector<std::string>& extensions) const {
-    IdentificationOptions o = options_.identification;
-    o.model = modelSpecOf(extensions);
-    const StackedSystem sys = buildFreeDecaySystem({record}, o);
-    NestedFit f = fitSystem(sys, o, extensions);
-    f.estimate = identifyFreeDecay(record, o);  // honest lag-2 sandwich intervals
+    PipelineOptions p;
+    p.method = Method::kCeres;
+    p.identification = options_.identification;
+    p.identification.model = ResonatorModel(extensions, ExperimentMode::kFreeDecay).spec();
+    p.ceres = options_.ceres;
+    p.ceres.rk4_substeps = options_.rk4_substeps;
+    // A failed refinement keeps the LS answer (honest sandwich intervals) and says why.
+    p.on_ceres_failure = CeresFailure::kKeepStart;
+    const StackedSystem sys = buildFreeDecaySystem({record}, p.identification);
+    NestedFit f = fitSystem(sys, p.identification, extensions);
+    f.estimate = identify(record, p);
     f.residuals = equationResiduals(sys, f.estimate.values);
-    f.rss = f.residuals.squaredNorm();
     f.sigma = f.estimate.sigma;
-    CeresOptions c = options_.ceres;
-    c.confidence = o.confidence;
-    c.rk4_substeps = options_.rk4_substeps;
-    try {
-      f.estimate = refineWithCeres(record, f.estimate, c);
-    } catch (const AnalysisError& err) {
-      // Keep the LS answer (honest sandwich intervals) and say why.
-      f.estimate.notes.push_back(std::string("output-error refinement failed, equation-error LS "
-                                             "kept (its xi-type terms carry an EIV bias): ") +
-                                 err.what());
+    if (f.estimate.method != methodName(Method::kCeres)) {
+      f.rss = f.residuals.squaredNorm();
       return f;
     }
-    f.residuals = equationResiduals(sys, f.estimate.values);
-    f.sigma = f.estimate.sigma;
     f.n_equations = f.estimate.n_equations;
     f.rss = f.sigma * f.sigma * std::max(1, f.estimate.dof);
     return f;
@@ -194,7 +190,7 @@ class ForcedFitter : public NestedModelFitter {
  public:
   ForcedFitter(const SweepRecord& record, const NestedFitterOptions& options)
       : record_(record), options_(options) {
-    throwIfInvalid(options);
+    throwIfInvalid("invalid explain fitting options", options.validate());
     omega_ = options.identification.omega_rad_s > 0 ? options.identification.omega_rad_s
                                                     : record.omega_rad_s;
     if (!(omega_ > 0.0))
@@ -236,24 +232,13 @@ class ForcedFitter : public NestedModelFitter {
   }
 
  private:
-  static bool hasMu(const std::vector<std::string>& ext) {
-    for (const auto& e : ext)
-      if (e == "mu") return true;
-    return false;
-  }
-  static std::vector<std::string> withoutMu(const std::vector<std::string>& ext) {
-    std::vector<std::string> out;
-    for (const auto& e : ext)
-      if (e != "mu") out.push_back(e);
-    return out;
-  }
-
   /// The linear (in z) part's options: the base spec and the fitted mu when mu is estimated.
   IdentificationOptions optionsFor(const std::vector<std::string>& ext, const NestedFit& f) const {
     IdentificationOptions o = options_.identification;
     o.omega_rad_s = omega_;
-    o.model = modelSpecOf(withoutMu(ext));
-    if (hasMu(ext)) o.mu = f.estimate.parameters.at("mu").value;
+    const ResonatorModel model(ext, ExperimentMode::kForced);
+    o.model = model.linearPart().spec();
+    if (model.estimatesMu()) o.mu = f.estimate.parameters.at(ResonatorModel::muName()).value;
     return o;
   }
 
@@ -262,27 +247,28 @@ class ForcedFitter : public NestedModelFitter {
     Eigen::VectorXd z(f.estimate.values.size());
     int k = 0;
     for (size_t i = 0; i < f.estimate.names.size(); ++i)
-      if (f.estimate.names[i] != "mu") z[k++] = f.estimate.values[i];
+      if (f.estimate.names[i] != ResonatorModel::muName()) z[k++] = f.estimate.values[i];
     return z.head(k);
   }
 
   NestedFit fitOn(const SweepRecord& record, const std::vector<std::string>& extensions) const {
+    const ResonatorModel model(extensions, ExperimentMode::kForced);
     IdentificationOptions o = options_.identification;
     o.omega_rad_s = omega_;
-    o.model = modelSpecOf(withoutMu(extensions));
-    NestedFit f = fitRecord(record, o, extensions);
-    if (!hasMu(extensions)) return f;
-    // mu multiplies u~ bilinearly (3.2): estimate it by output error, then refit z by LS at that
-    // mu so that sigma and the residuals stay in equation units.
-    Estimate start = f.estimate;
-    start.model = modelSpecOf(withoutMu(extensions)) + "+mu";
-    CeresOptions c = options_.ceres;
-    c.confidence = o.confidence;
-    const Estimate ceres = refineWithCeres(record, start, c);
-    o.mu = ceres.parameters.at("mu").value;
+    o.model = model.linearPart().spec();
+    if (!model.estimatesMu()) return fitRecord(record, o, extensions);
+    // mu multiplies u~ bilinearly (3.2): the pipeline estimates it by output error, then z is
+    // refitted by LS at that mu so that sigma and the residuals stay in equation units.
+    PipelineOptions p;
+    p.method = Method::kCeres;
+    p.identification = o;
+    p.identification.model = model.spec();
+    p.ceres = options_.ceres;
+    const Estimate ceres = identify(record, p);
+    o.mu = ceres.parameters.at(ResonatorModel::muName()).value;
     NestedFit refit = fitRecord(record, o, extensions);
     refit.estimate = ceres;
-    refit.model = modelSpecOf(extensions);
+    refit.model = model.spec();
     return refit;
   }
 

@@ -8,10 +8,13 @@
 #include <sstream>
 
 #include "cvg_bench/core/demod/demodulator_noise.h"
+#include "cvg_bench/core/estimate/collinearity.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/estimate/hac_covariance.h"
 #include "cvg_bench/core/estimate/identifiability.h"
 #include "cvg_bench/core/estimate/output_error_forced.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
+#include "cvg_bench/core/estimate/residual_correlation.h"
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 
@@ -64,13 +67,8 @@ Eigen::VectorXd startVector(const ResonatorModel& model, const Estimate& start) 
   return z;
 }
 
-bool modelHasMu(const ResonatorModel& model) {
-  const auto& e = model.extensionNames();
-  return std::find(e.begin(), e.end(), "mu") != e.end();
-}
-
 double startMu(const Estimate& start, const CeresOptions& options) {
-  const auto it = std::find(start.names.begin(), start.names.end(), "mu");
+  const auto it = std::find(start.names.begin(), start.names.end(), ResonatorModel::muName());
   if (it != start.names.end()) {
     const double v = start.values[it - start.names.begin()];
     if (std::isfinite(v)) return v;
@@ -121,156 +119,230 @@ Eigen::MatrixXd denseJacobian(const ceres::CRSMatrix& crs) {
   return j;
 }
 
-ParameterEstimate interval(double value, double variance, double s_p) {
-  ParameterEstimate p;
-  p.value = value;
-  p.std_error = std::sqrt(std::max(variance, 0.0));
-  p.ci_low = value - s_p * p.std_error;
-  p.ci_high = value + s_p * p.std_error;
-  return p;
+std::string fmt3(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
 }
 
-/// Rank, covariance, intervals, identifiability and derived quantities of the fitted problem.
-void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estimate* e) {
+/// Residuals, Jacobian (unscaled unknowns) and unknowns at the solution.
+struct AtSolution {
+  Eigen::MatrixXd j;
+  Eigen::VectorXd residuals;
+  Eigen::VectorXd x;      ///< all unknowns, unscaled
+  Eigen::VectorXd scale;  ///< blocks hold x / scale
+  double cost = 0.0;
+};
+
+AtSolution evaluateAtSolution(const FittedProblem& fp) {
   ceres::Problem::EvaluateOptions eo;
   eo.parameter_blocks = fp.blocks;
-  double cost = 0.0;
+  AtSolution a;
   std::vector<double> residuals;
   ceres::CRSMatrix crs;
-  if (!fp.problem->Evaluate(eo, &cost, &residuals, nullptr, &crs))
+  if (!fp.problem->Evaluate(eo, &a.cost, &residuals, nullptr, &crs))
     throw AnalysisError("Ceres refinement: residuals cannot be evaluated at the solution");
-  Eigen::MatrixXd j = denseJacobian(crs);
-  const Eigen::VectorXd scale =
-      fp.scale.size() == j.cols() ? fp.scale : Eigen::VectorXd::Ones(j.cols());
-  j = j * scale.cwiseInverse().asDiagonal();  // with respect to the unscaled unknowns
-  if (!j.allFinite()) throw AnalysisError("Ceres refinement: non-finite Jacobian at the solution");
-  const int n = j.rows(), p = j.cols();
+  a.j = denseJacobian(crs);
+  a.scale = fp.scale.size() == a.j.cols() ? fp.scale : Eigen::VectorXd::Ones(a.j.cols());
+  a.j = a.j * a.scale.cwiseInverse().asDiagonal();  // with respect to the unscaled unknowns
+  if (!a.j.allFinite())
+    throw AnalysisError("Ceres refinement: non-finite Jacobian at the solution");
+  a.residuals = Eigen::Map<const Eigen::VectorXd>(residuals.data(), residuals.size());
+  a.x.resize(a.j.cols());
+  for (size_t b = 0, o = 0; b < fp.blocks.size(); o += fp.block_sizes[b], ++b)
+    a.x.segment(o, fp.block_sizes[b]) =
+        Eigen::Map<const Eigen::VectorXd>(fp.blocks[b], fp.block_sizes[b]);
+  a.x = a.x.cwiseProduct(a.scale);
+  return a;
+}
 
-  // Numerical rank from the column-equilibrated Jacobian (same convention as the LS estimators).
-  Eigen::VectorXd norms = j.colwise().norm().transpose();
-  for (int c = 0; c < p; ++c)
-    if (norms[c] == 0.0) norms[c] = 1.0;
-  const Eigen::MatrixXd js = j * norms.cwiseInverse().asDiagonal();
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(js, Eigen::ComputeFullV);
-  const Eigen::VectorXd s = svd.singularValues();
+/// Numerical rank from the column-equilibrated Jacobian (same convention as the LS estimators).
+struct RankAnalysis {
   int rank = 0;
-  for (int i = 0; i < s.size(); ++i)
-    if (s[i] > options.rank_tolerance * s[0]) ++rank;
-  const int dof = n - rank;
-  if (dof < 1)
-    throw AnalysisError("Ceres refinement: no degrees of freedom left (" + std::to_string(n) +
-                        " residuals, rank " + std::to_string(rank) + ")");
-  const double sigma2 = 2.0 * cost / dof;
+  Eigen::VectorXd norms, s;
+  Eigen::MatrixXd v;
+};
 
+RankAnalysis numericalRank(const Eigen::MatrixXd& j, double tolerance) {
+  RankAnalysis r;
+  r.norms = j.colwise().norm().transpose();
+  for (Eigen::Index c = 0; c < r.norms.size(); ++c)
+    if (r.norms[c] == 0.0) r.norms[c] = 1.0;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(j * r.norms.cwiseInverse().asDiagonal(),
+                                              Eigen::ComputeFullV);
+  r.s = svd.singularValues();
+  r.v = svd.matrixV();
+  for (Eigen::Index i = 0; i < r.s.size(); ++i)
+    if (r.s[i] > tolerance * r.s[0]) ++r.rank;
+  return r;
+}
+
+/// (J'J)^+ in the unscaled unknowns: ceres::Covariance, or the truncated SVD of the
+/// column-equilibrated Jacobian where Ceres refuses.
+Eigen::MatrixXd unscaledCovariance(const FittedProblem& fp, const AtSolution& a,
+                                   const RankAnalysis& r, const CeresOptions& options,
+                                   Estimate* e) {
+  const int p = static_cast<int>(a.j.cols());
   ceres::Covariance::Options co;
   co.algorithm_type = ceres::DENSE_SVD;
-  co.null_space_rank = p - rank;
+  co.null_space_rank = p - r.rank;
   co.min_reciprocal_condition_number = options.min_reciprocal_condition_number;
   ceres::Covariance covariance(co);
   std::vector<const double*> cblocks(fp.blocks.begin(), fp.blocks.end());
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> cov(p, p);
-  Eigen::MatrixXd unscaled_cov;  // (J'J)^+ in the unscaled unknowns
   if (covariance.Compute(cblocks, fp.problem) &&
-      covariance.GetCovarianceMatrix(cblocks, cov.data())) {
-    unscaled_cov = scale.asDiagonal() * Eigen::MatrixXd(cov) * scale.asDiagonal();
-  } else {
-    // ceres::Covariance refused (its condition test runs on the unequilibrated J'J): the same
-    // pseudo-inverse from the SVD of the column-equilibrated Jacobian, truncated at the rank.
-    const Eigen::MatrixXd v = svd.matrixV().leftCols(rank);
-    const Eigen::VectorXd inv_s2 = s.head(rank).cwiseAbs2().cwiseInverse();
-    unscaled_cov = norms.cwiseInverse().asDiagonal() * v * inv_s2.asDiagonal() * v.transpose() *
-                   norms.cwiseInverse().asDiagonal();
-    e->notes.push_back(
-        "covariance from the SVD of the column-equilibrated Jacobian (ceres::Covariance judged "
-        "J'J too ill-conditioned before equilibration)");
-  }
-  Eigen::MatrixXd full_cov = sigma2 * unscaled_cov;
-  std::string interval_method =
-      "output error (Ceres): sigma^2 (J'J)^+ by ceres::Covariance DENSE_SVD, Student-t";
-  if (!fp.noise_correlation.empty()) {
-    // Known noise correlation Sigma (same channel, samples l apart: rho_l): with C = (J'J)^+ and
-    // S = J' Sigma J, cov = sigma^2 C S C and E[RSS] = sigma^2 (n - tr(C S)).
-    Eigen::MatrixXd s_mat = j.transpose() * j;
-    for (size_t l = 1; l <= fp.noise_correlation.size() && 4 * static_cast<long>(l) < n; ++l) {
-      const long rows = n - 4 * static_cast<long>(l);
-      const Eigen::MatrixXd a = j.topRows(rows).transpose() * j.bottomRows(rows);
-      s_mat += fp.noise_correlation[l - 1] * (a + a.transpose());
-    }
-    const double effective_dof = n - (unscaled_cov * s_mat).trace();
-    if (effective_dof > 0.0) {
-      const double sigma2_sample = 2.0 * cost / effective_dof;  // noise variance of one sample
-      full_cov = sigma2_sample * unscaled_cov * s_mat * unscaled_cov;
-      full_cov = 0.5 * (full_cov + full_cov.transpose());
-      std::ostringstream m;
-      m.precision(3);
-      m << "output error (Ceres): sigma^2 C J' Sigma J C, C = (J'J)^+ by ceres::Covariance "
-           "DENSE_SVD, Sigma the demodulator's noise correlation (rho_1 = "
-        << fp.noise_correlation[0] << ", " << fp.noise_correlation.size()
-        << " lags; the white-noise formula is ~15 % too narrow on demodulated samples), Student-t";
-      interval_method = m.str();
-    } else {
-      e->notes.push_back(
-          "the record's noise correlation leaves no degrees of freedom (n - tr(C J' Sigma J) <= "
-          "0): white-noise covariance reported, too narrow for filtered samples");
-    }
-  }
+      covariance.GetCovarianceMatrix(cblocks, cov.data()))
+    return a.scale.asDiagonal() * Eigen::MatrixXd(cov) * a.scale.asDiagonal();
+  // ceres::Covariance refused (its condition test runs on the unequilibrated J'J).
+  const Eigen::MatrixXd v = r.v.leftCols(r.rank);
+  const Eigen::VectorXd inv_s2 = r.s.head(r.rank).cwiseAbs2().cwiseInverse();
+  e->notes.push_back(
+      "covariance from the SVD of the column-equilibrated Jacobian (ceres::Covariance judged "
+      "J'J too ill-conditioned before equilibration)");
+  return r.norms.cwiseInverse().asDiagonal() * v * inv_s2.asDiagonal() * v.transpose() *
+         r.norms.cwiseInverse().asDiagonal();
+}
 
-  Eigen::VectorXd x(p);
-  for (size_t b = 0, o = 0; b < fp.blocks.size(); o += fp.block_sizes[b], ++b)
-    x.segment(o, fp.block_sizes[b]) =
-        Eigen::Map<const Eigen::VectorXd>(fp.blocks[b], fp.block_sizes[b]);
-  x = x.cwiseProduct(scale);  // back to the unscaled unknowns
+/// Lag-1 correlation of the residual 4-blocks (one sample / sweep point apart).
+double blockLagOne(const Eigen::VectorXd& r) {
+  const long n = r.size();
+  const double ss = r.squaredNorm();
+  if (n <= 8 || !(ss > 0.0)) return 0.0;
+  return r.tail(n - 4).dot(r.head(n - 4)) / ss;
+}
+
+/// Covariance of all unknowns: white (iid), the record's stated noise correlation, or HAC when
+/// the residuals' lag-1 correlation rejects what the assumed noise predicts.
+struct CeresCovariance {
+  Eigen::MatrixXd cov;
+  std::string method, id;
+};
+
+CeresCovariance outputErrorCovariance(const FittedProblem& fp, const AtSolution& a,
+                                      const Eigen::MatrixXd& unscaled, int dof, Estimate* e) {
+  const long n = a.j.rows();
+  CeresCovariance out;
+  out.cov = (2.0 * a.cost / dof) * unscaled;
+  out.id = "iid";
+  out.method = "output error (Ceres): sigma^2 (J'J)^+ by ceres::Covariance DENSE_SVD, Student-t";
+  // The null: white residuals, or the stated correlation rho_1 with Bartlett's variance factor.
+  double expected = 0.0, factor = 1.0;
+  for (size_t l = 0; l < fp.noise_correlation.size(); ++l)
+    factor += 2.0 * fp.noise_correlation[l] * fp.noise_correlation[l];
+  if (!fp.noise_correlation.empty()) expected = fp.noise_correlation[0];
+  const SerialCorrelationTest test = testLagOne(blockLagOne(a.residuals), expected, factor, n / 4);
+  e->residual_lag1 = test.lag1;
+  e->residual_lag1_expected = test.expected;
+  e->residual_lag1_z = test.z;
+  e->residual_correlated = test.correlated;
+  e->noise_model = "white";
+  if (test.correlated && n % 4 == 0 && n / 4 > 3 * a.j.cols()) {
+    const HacCovariance hac = hacCovarianceBlocked(a.j, a.residuals, 4);
+    out.cov = hac.covariance;
+    out.id = "hac_bartlett_andrews";
+    e->noise_model = "serially correlated residuals (lag-1 correlation " + fmt3(test.lag1) +
+                     ", z = " + fmt3(test.z) + " against " + fmt3(expected) + ")";
+    out.method = "output error (Ceres): " + hac.method + ", Student-t";
+    return out;
+  }
+  if (fp.noise_correlation.empty()) return out;
+  // Known noise correlation Sigma (same channel, samples l apart: rho_l): with C = (J'J)^+ and
+  // S = J' Sigma J, cov = sigma^2 C S C and E[RSS] = sigma^2 (n - tr(C S)).
+  const Eigen::MatrixXd& j = a.j;
+  Eigen::MatrixXd s_mat = j.transpose() * j;
+  for (size_t l = 1; l <= fp.noise_correlation.size() && 4 * static_cast<long>(l) < n; ++l) {
+    const long rows = n - 4 * static_cast<long>(l);
+    const Eigen::MatrixXd m = j.topRows(rows).transpose() * j.bottomRows(rows);
+    s_mat += fp.noise_correlation[l - 1] * (m + m.transpose());
+  }
+  const double effective_dof = n - (unscaled * s_mat).trace();
+  if (!(effective_dof > 0.0)) {
+    e->notes.push_back(
+        "the record's noise correlation leaves no degrees of freedom (n - tr(C J' Sigma J) <= "
+        "0): white-noise covariance reported, too narrow for filtered samples");
+    return out;
+  }
+  const double sigma2_sample = 2.0 * a.cost / effective_dof;  // noise variance of one sample
+  out.cov = sigma2_sample * unscaled * s_mat * unscaled;
+  out.cov = 0.5 * (out.cov + out.cov.transpose());
+  out.id = "demod_correlation";
+  e->noise_model = "stated by the record (demodulator): rho_1 = " + fmt3(fp.noise_correlation[0]) +
+                   ", " + std::to_string(fp.noise_correlation.size()) + " lag(s)";
+  out.method =
+      "output error (Ceres): sigma^2 C J' Sigma J C, C = (J'J)^+ by ceres::Covariance "
+      "DENSE_SVD, Sigma the demodulator's noise correlation (rho_1 = " +
+      fmt3(fp.noise_correlation[0]) + ", " + std::to_string(fp.noise_correlation.size()) +
+      " lags; the white-noise formula is ~15 % too narrow on demodulated samples), Student-t";
+  return out;
+}
+
+/// Exact rank deficiency (identifiability.h) or near-collinearity (collinearity.h).
+void fillIdentifiability(const FittedProblem& fp, const AtSolution& a, const RankAnalysis& r,
+                         const Eigen::MatrixXd& cov, double s_p, Estimate* e) {
+  const int p = static_cast<int>(a.j.cols());
+  e->unidentifiable.clear();
+  e->not_identified.clear();
+  e->identifiability_note.clear();
+  e->combinations.clear();
+  if (r.rank == p) {
+    // S V' diag(norms) has the Gram J'J: the SVD already taken, without the n rows again.
+    const Eigen::MatrixXd factor = r.s.asDiagonal() * r.v.transpose() * r.norms.asDiagonal();
+    reportCollinearity(analyzeCollinearity(fp.all_names, factor, fp.n_reported), fp.all_names, a.x,
+                       cov, summarizeExcitation(*fp.q), s_p, e);
+    return;
+  }
+  Eigen::MatrixXd null_space = r.norms.cwiseInverse().asDiagonal() * r.v.rightCols(p - r.rank);
+  null_space.colwise().normalize();
+  const IdentifiabilityReport report =
+      analyzeIdentifiability(fp.all_names, null_space, r.norms, summarizeExcitation(*fp.q));
+  e->unidentifiable = report.unidentifiable;
+  e->identifiability_note = report.note;
+  for (const auto& c : report.combinations)
+    e->combinations[c.name] =
+        interval(c.coefficients.dot(a.x), c.coefficients.dot(cov * c.coefficients), s_p);
+  e->notes.push_back("rank-deficient output-error fit (rank " + std::to_string(r.rank) + " of " +
+                     std::to_string(p) +
+                     "): intervals of the unidentifiable parameters are not meaningful");
+}
+
+/// Rank, covariance, intervals, identifiability and derived quantities of the fitted problem.
+void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estimate* e) {
+  const AtSolution a = evaluateAtSolution(fp);
+  const int n = static_cast<int>(a.j.rows()), p = static_cast<int>(a.j.cols());
+  const RankAnalysis r = numericalRank(a.j, options.rank_tolerance);
+  const int dof = n - r.rank;
+  if (dof < 1)
+    throw AnalysisError("Ceres refinement: no degrees of freedom left (" + std::to_string(n) +
+                        " residuals, rank " + std::to_string(r.rank) + ")");
+  const Eigen::MatrixXd unscaled = unscaledCovariance(fp, a, r, options, e);
+  const CeresCovariance cc = outputErrorCovariance(fp, a, unscaled, dof, e);
 
   const int k = fp.n_reported;
   const double s_p = studentQuantile(options.confidence, dof);
   e->method = "ceres";
   e->n_equations = n;
   e->n_params = k;
-  e->rank = std::max(0, rank - (p - k));
+  e->rank = std::max(0, r.rank - (p - k));
   e->dof = dof;
-  e->sigma = std::sqrt(sigma2);
+  e->sigma = std::sqrt(2.0 * a.cost / dof);
   e->confidence = options.confidence;
   e->names.assign(fp.all_names.begin(), fp.all_names.begin() + k);
-  e->values = x.head(k);
-  e->covariance = full_cov.topLeftCorner(k, k);
+  e->values = a.x.head(k);
+  e->covariance = cc.cov.topLeftCorner(k, k);
   e->parameters.clear();
-  for (int i = 0; i < k; ++i) e->parameters[e->names[i]] = interval(x[i], full_cov(i, i), s_p);
-  e->interval_method = interval_method;
+  for (int i = 0; i < k; ++i) e->parameters[e->names[i]] = interval(a.x[i], cc.cov(i, i), s_p);
+  e->interval_method = cc.method;
+  e->interval_method_id = cc.id;
   e->interval_dof = dof;
   e->covariance_paper.resize(0, 0);
   e->parameters_paper.clear();
-  e->singular_values.assign(s.data(), s.data() + s.size());
+  e->singular_values.assign(r.s.data(), r.s.data() + r.s.size());
   e->rank_tolerance = options.rank_tolerance;
-
-  e->unidentifiable.clear();
-  e->identifiability_note.clear();
-  e->combinations.clear();
-  if (rank < p) {
-    Eigen::MatrixXd null_space =
-        norms.cwiseInverse().asDiagonal() * svd.matrixV().rightCols(p - rank);
-    null_space.colwise().normalize();
-    const IdentifiabilityReport report =
-        analyzeIdentifiability(fp.all_names, null_space, norms, summarizeExcitation(*fp.q));
-    e->unidentifiable = report.unidentifiable;
-    e->identifiability_note = report.note;
-    for (const auto& c : report.combinations) {
-      e->combinations[c.name] =
-          interval(c.coefficients.dot(x), c.coefficients.dot(full_cov * c.coefficients), s_p);
-    }
-    e->notes.push_back("rank-deficient output-error fit (rank " + std::to_string(rank) + " of " +
-                       std::to_string(p) +
-                       "): intervals of the unidentifiable parameters are not meaningful");
-  }
-
+  fillIdentifiability(fp, a, r, cc.cov, s_p, e);
   e->derived.clear();
-  if (options.derive_quantities && e->omega_rad_s > 0 && rank == p) {
-    try {
-      e->derived = deriveQuantitiesWithIntervals(uncertainParameters(*e), e->omega_rad_s,
-                                                 options.angular_gain_k);
-    } catch (const InputError& err) {
-      e->notes.push_back(std::string("derived quantities not computed: ") + err.what());
-    }
-  }
+  e->derived_method.clear();
+  if (options.derive_quantities) deriveFromIdentified(e, e->omega_rad_s, options.angular_gain_k);
 }
 
 void checkTimes(const SlowRecord& record) {
@@ -397,7 +469,7 @@ Estimate refineWithCeres(const SweepRecord& record, const Estimate& start,
       throw InputError(where + ": bad value (non-finite or omega0 <= 0) at point " +
                        std::to_string(j));
   }
-  const bool estimate_mu = modelHasMu(model);
+  const bool estimate_mu = model.estimatesMu();
   const int k = model.numParameters();
   const int n_unknowns = k + (estimate_mu ? 1 : 0);
 
@@ -465,7 +537,7 @@ Estimate refineWithCeres(const SweepRecord& record, const Estimate& start,
   if (estimate_mu) {
     fp.blocks.push_back(&mu);
     fp.block_sizes.push_back(1);
-    fp.all_names.push_back("mu");
+    fp.all_names.push_back(ResonatorModel::muName());
   }
   fp.n_reported = n_unknowns;
   fp.q = &used_q;

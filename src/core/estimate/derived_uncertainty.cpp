@@ -1,6 +1,8 @@
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "cvg_bench/core/estimate/derived_quantities.h"
 #include "cvg_bench/core/estimate/student_t.h"
@@ -46,12 +48,7 @@ ParameterEstimate deltaMethod(const std::function<double(const ParameterValues&)
     minus[p.cov_names[j]] = v - h;
     grad[j] = (f(plus) - f(minus)) / (2.0 * h);
   }
-  const double var = grad.dot(p.covariance * grad);
-  out.std_error = std::sqrt(std::max(0.0, var));
-  const double s_p = studentQuantile(p.confidence, p.dof);
-  out.ci_low = out.value - s_p * out.std_error;
-  out.ci_high = out.value + s_p * out.std_error;
-  return out;
+  return interval(out.value, grad.dot(p.covariance * grad), studentQuantile(p.confidence, p.dof));
 }
 
 std::map<std::string, ParameterEstimate> deriveQuantitiesWithIntervals(const UncertainParameters& p,
@@ -72,6 +69,72 @@ std::map<std::string, ParameterEstimate> deriveQuantitiesWithIntervals(const Unc
 ParameterEstimate driftRateWithInterval(double r, double k, double theta,
                                         const UncertainParameters& p) {
   return deltaMethod([&](const ParameterValues& v) { return driftRate(r, k, theta, v); }, p);
+}
+
+ParameterEstimate qualityFactorFromRate(double omega_rad_s, double rate, double rate_variance,
+                                        double confidence, int dof) {
+  if (!(rate > 0.0) || !std::isfinite(rate))
+    throw InputError("the decay rate " + std::to_string(rate) + " 1/s is not positive: no Q");
+  ParameterEstimate q;
+  const double sd = std::sqrt(std::max(0.0, rate_variance));
+  const double s_p = studentQuantile(confidence, dof);
+  q.value = omega_rad_s / rate;
+  q.std_error = q.value * sd / rate;
+  const double low_rate = rate - s_p * sd;
+  q.ci_low = omega_rad_s / (rate + s_p * sd);
+  q.ci_high = low_rate > 0.0 ? omega_rad_s / low_rate : std::numeric_limits<double>::infinity();
+  return q;
+}
+
+namespace {
+
+bool contains(const std::vector<std::string>& v, const std::string& x) {
+  return std::find(v.begin(), v.end(), x) != v.end();
+}
+
+}  // namespace
+
+void deriveFromIdentified(Estimate* e, double omega_rad_s, double angular_gain_k) {
+  e->derived.clear();
+  e->derived_method.clear();
+  if (!(omega_rad_s > 0.0)) {
+    e->notes.push_back("derived quantities not computed: omega unknown (give --omega)");
+    return;
+  }
+  const int k = static_cast<int>(e->names.size());
+  const bool full_rank = e->rank >= e->n_params;
+  if (full_rank) {
+    try {
+      e->derived =
+          deriveQuantitiesWithIntervals(uncertainParameters(*e), omega_rad_s, angular_gain_k);
+    } catch (const InputError& err) {
+      e->notes.push_back(std::string("derived quantities not computed: ") + err.what());
+    }
+  }
+  const Eigen::VectorXd& c = e->envelope_coefficients;
+  if (!full_rank || c.size() != k || e->values.size() != k || e->covariance.rows() != k) return;
+  const std::string how =
+      "from the envelope decay of this record: gamma_env = -sum q' D(q) z / sum |q|^2 dt "
+      "(section 4's Q = omega/gamma with the record's own damping of |q|^2)";
+  try {
+    const ParameterEstimate q_env = qualityFactorFromRate(
+        omega_rad_s, c.dot(e->values), c.dot(e->covariance * c), e->confidence, e->interval_dof);
+    e->derived["Q_envelope"] = q_env;
+    e->derived_method["Q_envelope"] = how;
+    const bool gamma_unknown =
+        contains(e->not_identified, "gamma") || contains(e->unidentifiable, "gamma");
+    if (gamma_unknown) {
+      e->derived["Q"] = q_env;
+      e->derived_method["Q"] =
+          "Q " + how +
+          "; the split of the damping between gamma and the anisotropy b is not "
+          "identified by this record, so omega/gamma is not reported";
+    } else if (e->derived.count("Q")) {
+      e->derived_method["Q"] = "omega/gamma";
+    }
+  } catch (const InputError& err) {
+    e->notes.push_back(std::string("Q from the envelope not computed: ") + err.what());
+  }
 }
 
 }  // namespace cvg_bench

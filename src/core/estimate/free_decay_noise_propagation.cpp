@@ -66,6 +66,8 @@ void FreeDecayNoisePropagation::finish(SampleTerms& a, const Eigen::Vector4d& q,
   const Eigen::Matrix4d gt = g.transpose();
   sensitivityColumns(a.u, a.v, gt.data(), k_, w_.data());
   gram_.add(w_);
+  if (sink_) sink_(w_, next_first_);
+  next_first_ = false;
   noise_gain_ += 4.0 * a.s2 - 2.0 * a.sw * g.trace() + a.w2 * g.squaredNorm();
 }
 
@@ -93,6 +95,7 @@ void FreeDecayNoisePropagation::add(const RegressionBlock& b) {
     finish(mid, b.q, b.abscissa);
     finish(next, b.q_next, b.t_next);
     in_record_ = 0;
+    next_first_ = true;
   }
 }
 

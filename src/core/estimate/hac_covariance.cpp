@@ -161,6 +161,25 @@ HacCovariance hacCovarianceBlocked(const Eigen::MatrixXd& jacobian,
   return out;
 }
 
+HacCovariance hacCovarianceFromScores(const Eigen::MatrixXd& scores, const Eigen::MatrixXd& r_pinv,
+                                      long n_rows, int rank, int lag) {
+  const long nb = scores.rows();
+  if (nb < 3 || scores.cols() != r_pinv.rows() || r_pinv.rows() != r_pinv.cols() || n_rows <= rank)
+    throw InputError("HAC covariance: " + std::to_string(nb) + " score rows of " +
+                     std::to_string(scores.cols()) + " for a " + std::to_string(r_pinv.rows()) +
+                     "-parameter factor and " + std::to_string(n_rows) + " rows");
+  if (!scores.allFinite()) throw InputError("HAC covariance: non-finite scores");
+  HacCovariance out;
+  const Eigen::MatrixXd h = scores * r_pinv;  // h_t = r_pinv' g_t: unit bread coordinates
+  const Eigen::MatrixXd meat = longRunCovariance(h, lag, nb - 1, &out.lag);
+  const double small_sample = static_cast<double>(n_rows) / static_cast<double>(n_rows - rank);
+  out.covariance = small_sample * r_pinv * meat * r_pinv.transpose();
+  out.method = "HAC Newey-West, Bartlett, lag " + std::to_string(out.lag) +
+               (lag < 0 ? " (Andrews AR(1)) after VAR(1) prewhitening" : " (given)") +
+               " of the per-step scores";
+  return out;
+}
+
 HacCovariance hacCovariance(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& residuals,
                             int lag) {
   return hacCovarianceBlocked(jacobian, residuals, 1, lag);

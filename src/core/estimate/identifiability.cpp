@@ -10,7 +10,8 @@ namespace cvg_bench {
 namespace {
 
 bool isNonlinear(const std::string& name) {
-  return name == "xi" || name == "kappa" || name == "gamma_nl" || name == "xi_diff";
+  return name == "xi" || name == "kappa" || name == "gamma_nl" || name == "xi_diff" ||
+         name == "xi_k";
 }
 
 std::string coefficientText(double c, bool first) {

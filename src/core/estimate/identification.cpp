@@ -4,15 +4,21 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/demod/demodulator_noise.h"
+#include "cvg_bench/core/estimate/collinearity.h"
+#include "cvg_bench/core/estimate/correlated_noise_gram.h"
+#include "cvg_bench/core/estimate/data_sufficiency.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/forced_regression.h"
 #include "cvg_bench/core/estimate/free_decay_noise_propagation.h"
 #include "cvg_bench/core/estimate/free_decay_regression.h"
+#include "cvg_bench/core/estimate/hac_covariance.h"
 #include "cvg_bench/core/estimate/identifiability.h"
 #include "cvg_bench/core/estimate/internal/block_gram_accumulator.h"
 #include "cvg_bench/core/estimate/internal/regression_block_ops.h"
 #include "cvg_bench/core/estimate/least_squares_solver.h"
 #include "cvg_bench/core/estimate/recursive_least_squares.h"
+#include "cvg_bench/core/estimate/residual_correlation.h"
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 
@@ -34,6 +40,8 @@ struct SystemInfo {
   std::vector<std::string> notes;
   /// Free decay: the model (for d(D(q) z)/dq of the honest covariance); null for stacked systems.
   const ResonatorModel* resonator = nullptr;
+  /// Free decay: the noise correlation the record states (demodulator_noise.h); empty = unknown.
+  std::vector<double> noise_correlation;
 };
 
 /// ExcitationSummary of the centre samples, accumulated in squares (no square roots per sample).
@@ -74,27 +82,22 @@ std::string fmt(double v) {
 }
 
 void throwIfInvalid(const IdentificationOptions& o) {
-  const auto problems = o.validate();
-  if (problems.empty()) return;
-  std::string msg = "invalid identification options:";
-  for (const auto& p : problems) msg += " " + p + ";";
-  throw InputError(msg);
+  cvg_bench::throwIfInvalid("invalid identification options", o.validate());
 }
 
-ParameterEstimate interval(double value, double variance, double s_p) {
-  ParameterEstimate p;
-  p.value = value;
-  p.std_error = std::sqrt(std::max(0.0, variance));
-  p.ci_low = value - s_p * p.std_error;
-  p.ci_high = value + s_p * p.std_error;
-  return p;
-}
+/// Pass 1: QR of the whole system (and RLS over the same blocks); fills the estimate's size, rank
+/// and values.
+struct SolvedSystem {
+  LeastSquaresSolution ls;
+  Eigen::MatrixXd r;  ///< k x k triangular factor (for the collinearity analysis)
+  long n = 0;
+  ExcitationSummary excitation;
+};
 
-Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
-                      const IdentificationOptions& opt) {
+SolvedSystem solveSystem(const BlockStream& stream, const SystemInfo& info,
+                         const IdentificationOptions& opt, Estimate* e) {
   const int k = static_cast<int>(info.names.size());
   const bool rls = opt.method == "rls";
-  // ---- pass 1: QR of the whole system (and RLS over the same blocks)
   IncrementalQr qr(k);
   SquaredExcitation excitation;
   const int m_init = opt.rls_init_blocks > 0 ? opt.rls_init_blocks : std::max(2 * k, 8);
@@ -121,37 +124,40 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
     }
     ++block_no;
   });
-  const long n = qr.numRows();
-  if (n <= k)
-    throw InputError(std::to_string(n) + " equations for " + std::to_string(k) +
+  SolvedSystem s;
+  s.n = qr.numRows();
+  if (s.n <= k)
+    throw InputError(std::to_string(s.n) + " equations for " + std::to_string(k) +
                      " parameters of model " + info.model + ": more data needed (n > k)");
-  const LeastSquaresSolution ls = solveTriangular(qr.rAug(), n, opt.rank_tolerance);
+  s.r = qr.rAug().topLeftCorner(k, k);
+  s.ls = solveTriangular(qr.rAug(), s.n, opt.rank_tolerance);
+  s.excitation = excitation.summary();
+  const LeastSquaresSolution& ls = s.ls;
 
-  Estimate e;
-  e.mode = info.mode;
-  e.model = info.model;
-  e.method = opt.method;
-  e.omega_rad_s = info.omega_rad_s;
-  e.n_equations = static_cast<int>(n);
-  e.n_params = k;
-  e.rank = ls.rank;
-  e.dof = static_cast<int>(n - ls.rank);
-  e.confidence = opt.confidence;
-  e.names = info.names;
-  e.rank_tolerance = opt.rank_tolerance;
-  e.singular_values.assign(ls.singular_values.data(),
-                           ls.singular_values.data() + ls.singular_values.size());
-  e.notes = info.notes;
-  e.values = ls.z;
+  e->mode = info.mode;
+  e->model = info.model;
+  e->method = opt.method;
+  e->omega_rad_s = info.omega_rad_s;
+  e->n_equations = static_cast<int>(s.n);
+  e->n_params = k;
+  e->rank = ls.rank;
+  e->dof = static_cast<int>(s.n - ls.rank);
+  e->confidence = opt.confidence;
+  e->names = info.names;
+  e->rank_tolerance = opt.rank_tolerance;
+  e->singular_values.assign(ls.singular_values.data(),
+                            ls.singular_values.data() + ls.singular_values.size());
+  e->notes = info.notes;
+  e->values = ls.z;
   if (rls) {
     if (rls_failed || !filter.initialized() || ls.rank < k) {
-      e.notes.push_back("RLS not run: the first " + std::to_string(m_init) +
-                        " blocks (or the whole record) do not determine all parameters; "
-                        "batch LS result reported");
-      e.method = "ls";
+      e->notes.push_back("RLS not run: the first " + std::to_string(m_init) +
+                         " blocks (or the whole record) do not determine all parameters; "
+                         "batch LS result reported");
+      e->method = "ls";
     } else {
-      e.values = filter.z();
-      e.notes.push_back(
+      e->values = filter.z();
+      e->notes.push_back(
           "block RLS (2.12) with the corrected pairing y_{i+1} - D_{i+1} z_i "
           "(docs/paper.md item 9), initialised by QR on the first " +
           std::to_string(m_init) + " blocks, forgetting factor " + fmt(opt.rls_forgetting) +
@@ -159,123 +165,237 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
           fmt(filter.predictionSigmaBound(filter.sigma())));
     }
   }
+  return s;
+}
 
-  // ---- pass 2: residuals and the honest covariance
-  const Eigen::VectorXd z = e.values;
-  const Eigen::MatrixXd& c = ls.unscaled_covariance;
-  const int dof_paper = static_cast<int>(n - ls.rank);
+/// The honest covariance of z-hat, its Student-t dof and the residual sum of squares.
+struct HonestCovariance {
+  Eigen::MatrixXd covariance;  ///< empty: the paper's (2.11)
+  int dof = 0;
   double rss = 0.0;
-  Eigen::MatrixXd honest;
-  int dof_honest = dof_paper;
-  if (info.mode == ExperimentMode::kFreeDecay && info.resonator != nullptr) {
-    // Errors in variables (free_decay_noise_propagation.h): D' Omega D = sigma_q^2 sum_m W_m W_m',
-    // sigma_q^2 = RSS / sum ||A_im||_F^2 x n / (n - k).
-    FreeDecayNoisePropagation propagation(*info.resonator, z);
-    double lag2 = 0.0;
-    Eigen::Vector4d r_hist[2] = {Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
-    long in_record = 0;
-    stream([&](int, const RegressionBlock& b) {
-      const Eigen::Vector4d r = blockResidual(*b.d, z, b.y);
-      rss += r.squaredNorm();
-      if (in_record >= 2) lag2 += r.dot(r_hist[1]);
-      r_hist[1] = r_hist[0];
-      r_hist[0] = r;
-      propagation.add(b);
-      in_record = b.last_in_record ? 0 : in_record + 1;
-    });
-    const double tr_a = propagation.noiseGain();
-    const double sigma_q2 = tr_a > 0.0 ? rss / tr_a * static_cast<double>(n) / dof_paper : 0.0;
-    honest = sigma_q2 * c * propagation.sensitivityGram() * c;
-    e.interval_method =
-        "errors-in-variables covariance of the differenced regression: sigma_q^2 C (sum_m W_m "
-        "W_m') C, W_m = sum_i D-bar_i' de_i/dq_m (samples shared by neighbouring equations of "
-        "(2.7), docs/paper.md item 10), white noise on q with sigma_q from the residuals";
-    e.notes.push_back("noise on q implied by the residuals: sigma_q = " + fmt(std::sqrt(sigma_q2)) +
-                      "; residual lag-2-block correlation " + fmt(rss > 0 ? lag2 / rss : 0.0) +
-                      " (white noise on q predicts -0.5)");
+};
+
+constexpr int kResidualLags = 12;  // residual correlations used to fit the AR(1) noise model
+
+void recordCorrelationTest(const SerialCorrelationTest& t, Estimate* e) {
+  e->residual_lag1 = t.lag1;
+  e->residual_lag1_expected = t.expected;
+  e->residual_lag1_z = t.z;
+  e->residual_correlated = t.correlated;
+}
+
+/// Free decay (2.7): errors in variables, noise on q white, AR(1) (fitted to the residual
+/// correlations when the lag-1 test rejects independence) or the record's stated correlation.
+HonestCovariance freeDecayCovariance(const BlockStream& stream, const SystemInfo& info,
+                                     const SolvedSystem& s, Estimate* e) {
+  const int k = static_cast<int>(info.names.size());
+  const Eigen::VectorXd z = e->values;
+  const Eigen::MatrixXd& c = s.ls.unscaled_covariance;
+  const int dof_paper = static_cast<int>(s.n - s.ls.rank);
+  HonestCovariance h;
+  h.dof = dof_paper;
+  FreeDecayNoisePropagation propagation(*info.resonator, z);
+  ResidualLagAccumulator lags(kResidualLags);
+  Eigen::VectorXd env_num = Eigen::VectorXd::Zero(k);
+  double env_den = 0.0;
+  long blocks = 0;
+  bool record_start = true;
+  stream([&](int, const RegressionBlock& b) {
+    if (record_start) lags.startRecord();
+    const Eigen::Vector4d r = blockResidual(*b.d, z, b.y);
+    h.rss += r.squaredNorm();
+    lags.add(r);
+    propagation.add(b);
+    env_num.noalias() += b.d->transpose() * b.q;
+    env_den += b.q.squaredNorm() * (b.t_next - b.t_prev);
+    ++blocks;
+    record_start = b.last_in_record;
+  });
+  if (env_den > 0.0) e->envelope_coefficients = -env_num / env_den;
+  const std::vector<double> corr = lags.correlations();
+  const SerialCorrelationTest test = testLagOne(corr[0], 0.0, 1.5, lags.steps());
+  recordCorrelationTest(test, e);
+  NoiseCorrelation rho;
+  if (!info.noise_correlation.empty()) {
+    rho.lags = info.noise_correlation;
+    e->interval_method_id = "demod_correlation";
+    e->noise_model = "stated by the record (demodulator): " + rho.describe();
+  } else if (test.correlated) {
+    rho.ar1 = fitDifferencedAr1(corr);
+    e->interval_method_id = "eiv_ar1";
+    e->noise_model = "AR(1) on each slow variable, " + rho.describe() +
+                     " fitted to the residual correlations at lags 1-" +
+                     std::to_string(kResidualLags);
   } else {
-    // Sweep points are independent: per-point (cluster) sandwich from the residuals.
-    // sum of sc sc' with sc = D_j' r_j: four points' scores are the rows of one Gram block.
-    BlockGramAccumulator meat(k);
-    RegressionBlockMatrix scores = RegressionBlockMatrix::Zero(4, k);
-    int in_block = 0;
-    stream([&](int, const RegressionBlock& b) {
-      const Eigen::Vector4d r = blockResidual(*b.d, z, b.y);
-      rss += r.squaredNorm();
-      scores.row(in_block).noalias() = r.transpose() * (*b.d);
-      if (++in_block == 4) {
-        meat.add(scores);
-        in_block = 0;
-      }
-    });
-    if (in_block > 0) {
-      scores.bottomRows(4 - in_block).setZero();
+    e->interval_method_id = "eiv_white";
+    e->noise_model = "white";
+  }
+  Eigen::MatrixXd meat;
+  double gain = propagation.noiseGain();
+  if (rho.white()) {
+    meat = propagation.sensitivityGram();
+  } else {
+    // Pass 3: the sensitivities again, correlated (correlated_noise_gram.h). E[RSS] gains
+    // 2 rho_2 tr(A_i,i-1 A_i,i+1') ~ -32 rho_2 per equation block (A ~ -/+2 I; the w G parts
+    // of A are O(h ||G||) and left out).
+    FreeDecayNoisePropagation again(*info.resonator, z);
+    CorrelatedSensitivityGram gram(k, rho);
+    again.setSampleSink([&](const RegressionBlockMatrix& w, bool first) { gram.add(w, first); });
+    stream([&](int, const RegressionBlock& b) { again.add(b); });
+    meat = gram.sum();
+    gain -= 32.0 * rho.at(2) * static_cast<double>(blocks);
+  }
+  const double sigma_q2 = gain > 0.0 ? h.rss / gain * static_cast<double>(s.n) / dof_paper : 0.0;
+  h.covariance = sigma_q2 * c * meat * c;
+  e->interval_method =
+      "errors-in-variables covariance of the differenced regression: sigma_q^2 C (sum_m,m' "
+      "rho_|m-m'| W_m W_m') C, W_m = sum_i D-bar_i' de_i/dq_m (samples shared by neighbouring "
+      "equations of (2.7), docs/paper.md item 10), noise on q " +
+      e->noise_model + ", sigma_q from the residuals";
+  e->notes.push_back("noise on q implied by the residuals: sigma_q = " + fmt(std::sqrt(sigma_q2)) +
+                     "; residual lag-1 correlation " + fmt(test.lag1) + " (z = " + fmt(test.z) +
+                     "; white noise on q predicts 0), lag-2 " + fmt(corr[1]) + " (white: -0.5)");
+  return h;
+}
+
+/// Forced sweeps (3.5): per-point (cluster) sandwich; HAC over the points in sweep order when
+/// their residuals are serially correlated.
+HonestCovariance sweepCovariance(const BlockStream& stream, const SystemInfo& info,
+                                 const SolvedSystem& s, Estimate* e) {
+  const int k = static_cast<int>(info.names.size());
+  const Eigen::VectorXd z = e->values;
+  const Eigen::MatrixXd& c = s.ls.unscaled_covariance;
+  const int dof_paper = static_cast<int>(s.n - s.ls.rank);
+  HonestCovariance h;
+  // sum of sc sc' with sc = D_j' r_j: four points' scores are the rows of one Gram block.
+  BlockGramAccumulator meat(k);
+  RegressionBlockMatrix scores = RegressionBlockMatrix::Zero(4, k);
+  std::vector<double> all_scores;  // per point, k each, in order (for HAC)
+  ResidualLagAccumulator lags(1);
+  int in_block = 0, last_record = -1;
+  stream([&](int record, const RegressionBlock& b) {
+    if (record != last_record) lags.startRecord();
+    last_record = record;
+    const Eigen::Vector4d r = blockResidual(*b.d, z, b.y);
+    h.rss += r.squaredNorm();
+    lags.add(r);
+    scores.row(in_block).noalias() = r.transpose() * (*b.d);
+    for (int j = 0; j < k; ++j) all_scores.push_back(scores(in_block, j));
+    if (++in_block == 4) {
       meat.add(scores);
+      in_block = 0;
     }
-    const double g = static_cast<double>(std::max(2L, info.num_clusters));
-    const double factor = g / (g - 1.0) * static_cast<double>(n - 1) / dof_paper;
-    honest = factor * c * meat.sum() * c;
-    dof_honest = static_cast<int>(std::max(1L, info.num_clusters - 1));
-    e.interval_method =
-        "per-point (cluster) sandwich (D'D)^-1 D' Omega D (D'D)^-1, Omega block-diagonal from the "
-        "residuals (noisy q enters y and D of a point), x G/(G-1) (n-1)/(n-k), t with G-1 dof";
-    if (info.mode == ExperimentMode::kFreeDecay) {
-      honest = Eigen::MatrixXd();
-      e.interval_method = "paper (2.11) (a stacked system carries no sample structure)";
-    }
+  });
+  if (in_block > 0) {
+    scores.bottomRows(4 - in_block).setZero();
+    meat.add(scores);
   }
-  e.sigma = std::sqrt(rss / dof_paper);
-  e.covariance_paper = e.sigma * e.sigma * c;
-  if (honest.size() == 0) honest = e.covariance_paper;
-  honest = 0.5 * (honest + honest.transpose());
-  bool honest_ok = true;
-  for (int j = 0; j < k; ++j)
-    if (!(honest(j, j) >= 0.0) || !std::isfinite(honest(j, j))) honest_ok = false;
-  if (!honest_ok) {
-    honest = e.covariance_paper;
-    dof_honest = dof_paper;
-    e.interval_method = "paper (2.11) (the sandwich was not positive; too few equations)";
+  const SerialCorrelationTest test = testLagOne(lags.correlations()[0], 0.0, 1.0, lags.steps());
+  recordCorrelationTest(test, e);
+  const long points = static_cast<long>(all_scores.size()) / k;
+  h.dof = static_cast<int>(std::max(1L, info.num_clusters - 1));
+  if (test.correlated && points >= 3 * k) {
+    const Eigen::MatrixXd g =
+        Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+            all_scores.data(), points, k);
+    const HacCovariance hac = hacCovarianceFromScores(g, s.ls.r_pinv, s.n, s.ls.rank);
+    h.covariance = hac.covariance;
+    e->interval_method_id = "hac_bartlett_andrews";
+    e->noise_model = "serially correlated over the sweep points (lag-1 residual correlation " +
+                     fmt(test.lag1) + ", z = " + fmt(test.z) + ")";
+    e->interval_method = hac.method + " over the sweep points in order, t with G-1 dof";
+    return h;
   }
-  e.covariance = honest;
-  e.interval_dof = dof_honest;
-  const double sp_paper = studentQuantile(opt.confidence, dof_paper);
-  const double sp_honest = studentQuantile(opt.confidence, dof_honest);
-  e.notes.push_back("\"parameters\" intervals: " + e.interval_method +
-                    "; \"parameters_paper_2_11\": the paper's (2.11), sigma-hat^2 (D'D)^-1 with "
-                    "Student-t at n-k dof, which assumes independent equation errors");
+  const double g = static_cast<double>(std::max(2L, info.num_clusters));
+  const double factor = g / (g - 1.0) * static_cast<double>(s.n - 1) / dof_paper;
+  h.covariance = factor * c * meat.sum() * c;
+  e->interval_method_id = "cluster_sandwich";
+  e->noise_model = "independent between sweep points";
+  e->interval_method =
+      "per-point (cluster) sandwich (D'D)^-1 D' Omega D (D'D)^-1, Omega block-diagonal from the "
+      "residuals (noisy q enters y and D of a point), x G/(G-1) (n-1)/(n-k), t with G-1 dof";
+  return h;
+}
 
-  // ---- identifiability
-  const IdentifiabilityReport idr =
-      analyzeIdentifiability(info.names, ls.null_space, ls.column_norms, excitation.summary());
-  e.unidentifiable = idr.unidentifiable;
-  e.identifiability_note = idr.note;
+/// A stacked free-decay system carries no sample structure: the paper's (2.11).
+HonestCovariance paperOnly(const BlockStream& stream, const Estimate& e) {
+  HonestCovariance h;
+  stream([&](int, const RegressionBlock& b) {
+    h.rss += blockResidual(*b.d, e.values, b.y).squaredNorm();
+  });
+  h.dof = e.dof;
+  return h;
+}
+
+/// Intervals of the parameters and the paper's (2.11) beside them; identifiability (exact rank
+/// and near-collinear) decides which parameters get a plain interval.
+void fillIntervals(const SolvedSystem& s, HonestCovariance h, const SystemInfo& info,
+                   const IdentificationOptions& opt, Estimate* e) {
+  const int k = static_cast<int>(info.names.size());
+  const int dof_paper = static_cast<int>(s.n - s.ls.rank);
+  e->sigma = std::sqrt(h.rss / dof_paper);
+  e->covariance_paper = e->sigma * e->sigma * s.ls.unscaled_covariance;
+  if (h.covariance.size() == 0) {
+    h.covariance = e->covariance_paper;
+    h.dof = dof_paper;
+    e->interval_method = "paper (2.11) (a stacked system carries no sample structure)";
+    e->interval_method_id = "paper_2_11";
+  }
+  h.covariance = 0.5 * (h.covariance + h.covariance.transpose());
   for (int j = 0; j < k; ++j) {
-    if (std::find(idr.unidentifiable.begin(), idr.unidentifiable.end(), info.names[j]) !=
-        idr.unidentifiable.end())
-      continue;
-    e.parameters[info.names[j]] = interval(e.values[j], honest(j, j), sp_honest);
-    e.parameters_paper[info.names[j]] = interval(e.values[j], e.covariance_paper(j, j), sp_paper);
-  }
-  for (const auto& comb : idr.combinations) {
-    e.combinations[comb.name] =
-        interval(comb.coefficients.dot(e.values), comb.coefficients.dot(honest * comb.coefficients),
-                 sp_honest);
-  }
-
-  // ---- derived quantities (section 4) by the delta method
-  if (opt.derive_quantities && ls.rank == k) {
-    const double omega = info.omega_rad_s;
-    if (omega > 0.0) {
-      try {
-        e.derived =
-            deriveQuantitiesWithIntervals(uncertainParameters(e), omega, opt.angular_gain_k);
-      } catch (const InputError& err) {
-        e.notes.push_back(std::string("derived quantities not computed: ") + err.what());
-      }
-    } else {
-      e.notes.push_back("derived quantities not computed: omega unknown (give --omega)");
+    if (!(h.covariance(j, j) >= 0.0) || !std::isfinite(h.covariance(j, j))) {
+      h.covariance = e->covariance_paper;
+      h.dof = dof_paper;
+      e->interval_method = "paper (2.11) (the sandwich was not positive; too few equations)";
+      e->interval_method_id = "paper_2_11";
+      break;
     }
   }
+  e->covariance = h.covariance;
+  e->interval_dof = h.dof;
+  const double sp_paper = studentQuantile(opt.confidence, dof_paper);
+  const double sp_honest = studentQuantile(opt.confidence, h.dof);
+  e->notes.push_back("\"parameters\" intervals: " + e->interval_method +
+                     "; \"parameters_paper_2_11\": the paper's (2.11), sigma-hat^2 (D'D)^-1 with "
+                     "Student-t at n-k dof, which assumes independent equation errors");
+
+  if (s.ls.rank < k) {
+    const IdentifiabilityReport idr =
+        analyzeIdentifiability(info.names, s.ls.null_space, s.ls.column_norms, s.excitation);
+    e->unidentifiable = idr.unidentifiable;
+    e->identifiability_note = idr.note;
+    for (const auto& comb : idr.combinations)
+      e->combinations[comb.name] =
+          interval(comb.coefficients.dot(e->values),
+                   comb.coefficients.dot(e->covariance * comb.coefficients), sp_honest);
+  } else {
+    reportCollinearity(analyzeCollinearity(info.names, s.r, k), info.names, e->values,
+                       e->covariance, s.excitation, sp_honest, e);
+  }
+  for (int j = 0; j < k; ++j) {
+    const std::string& name = info.names[j];
+    if (std::find(e->unidentifiable.begin(), e->unidentifiable.end(), name) !=
+        e->unidentifiable.end())
+      continue;
+    e->parameters[name] = interval(e->values[j], e->covariance(j, j), sp_honest);
+    e->parameters_paper[name] = interval(e->values[j], e->covariance_paper(j, j), sp_paper);
+  }
+}
+
+Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
+                      const IdentificationOptions& opt) {
+  Estimate e;
+  const SolvedSystem s = solveSystem(stream, info, opt, &e);
+  HonestCovariance h;
+  if (info.mode == ExperimentMode::kFreeDecay && info.resonator != nullptr) {
+    h = freeDecayCovariance(stream, info, s, &e);
+  } else if (info.mode == ExperimentMode::kForced) {
+    h = sweepCovariance(stream, info, s, &e);
+  } else {
+    h = paperOnly(stream, e);
+  }
+  fillIntervals(s, h, info, opt, &e);
+  if (opt.derive_quantities) deriveFromIdentified(&e, info.omega_rad_s, opt.angular_gain_k);
   return e;
 }
 
@@ -315,8 +435,8 @@ std::vector<std::string> IdentificationOptions::validate() const {
     p.push_back("method must be ls or rls (ceres: refineWithCeres), got '" + method + "'");
   if (!(confidence > 0.0 && confidence < 1.0))
     p.push_back("confidence must lie in (0, 1), got " + fmt(confidence));
-  if (!(std::isfinite(omega_rad_s) && omega_rad_s >= 0.0))
-    p.push_back("omega must be finite and >= 0 (0 = from the record), got " + fmt(omega_rad_s));
+  if (!(std::isfinite(omega_rad_s) && omega_rad_s >= 0.0 && omega_rad_s <= 1e10))
+    p.push_back("omega must be in [0, 1e10] rad/s (0 = from the record), got " + fmt(omega_rad_s));
   if (!(std::isfinite(angular_gain_k) && angular_gain_k > 0.0))
     p.push_back("angular gain K must be finite and > 0, got " + fmt(angular_gain_k));
   if (!std::isfinite(mu)) p.push_back("mu must be finite");
@@ -345,10 +465,12 @@ Estimate identifyFreeDecayRecords(const std::vector<const SlowRecord*>& records,
   info.max_lag_blocks = 2;
   info.resonator = &model;
   info.omega_rad_s = resolveOmega(options.omega_rad_s, records[0]->omega_rad_s, false, "");
+  info.noise_correlation = noiseCorrelationFromMetadata(records[0]->metadata);
   std::vector<bool> simpson(records.size());
   for (size_t r = 0; r < records.size(); ++r) {
     const SlowRecord& rec = *records[r];
     validateFreeDecayRecord(rec);
+    if (records.size() == 1) requireSufficientData(rec, model.numParameters());
     simpson[r] = hasUniformTimes(rec, options.uniform_time_tolerance);
     info.notes.push_back(
         (rec.source.empty() ? "record " + std::to_string(r) : rec.source) + ": " +
@@ -387,8 +509,7 @@ Estimate identifyForcedRecords(const std::vector<const SweepRecord*>& records,
   throwIfInvalid(options);
   if (records.empty()) throw InputError("no sweep record given");
   const ResonatorModel model(options.model, ExperimentMode::kForced);
-  const auto& ext = model.extensionNames();
-  if (std::find(ext.begin(), ext.end(), "mu") != ext.end())
+  if (model.estimatesMu())
     throw InputError(
         "model '" + model.spec() +
         "' estimates the control nonlinearity mu, which multiplies u~ bilinearly in (3.2): linear "
@@ -403,6 +524,7 @@ Estimate identifyForcedRecords(const std::vector<const SweepRecord*>& records,
                                   records[0]->source.empty() ? "sweep" : records[0]->source);
   for (const SweepRecord* r : records) {
     validateSweepRecord(*r);
+    if (records.size() == 1) requireSufficientData(*r, model.numParameters());
     info.num_clusters += static_cast<long>(r->size());
   }
   info.notes.push_back(

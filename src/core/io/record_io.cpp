@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
@@ -65,6 +66,18 @@ struct Table {
     for (const auto& n : names)
       if (columnIndex(n) < 0) return false;
     return true;
+  }
+  /// Locator of data row r (and a column by name) for the range checks.
+  RowLocator locator() const {
+    return [this](size_t r, const std::string& name) {
+      return where(row_line[r], columnIndex(name) + 1);
+    };
+  }
+  /// Magnitude checks of the named state columns (input_checks.h).
+  void checkStates(const std::vector<std::string>& names) const {
+    std::vector<std::pair<std::string, const std::vector<double>*>> cols;
+    for (const auto& n : names) cols.emplace_back(n, &columns[columnIndex(n)]);
+    checkStateColumns(cols, locator());
   }
 };
 
@@ -149,6 +162,7 @@ double metadataOmega(const Table& table) {
       v <= 0.0)
     throw InputError(table.where(table.metadata_line.at("omega")) + "# omega: '" + s +
                      "' is not a positive number [rad/s]");
+  requireOmegaInRange(v, table.where(table.metadata_line.at("omega")) + "# omega");
   return v;
 }
 
@@ -205,6 +219,8 @@ std::vector<Eigen::Vector4d> slowColumns(const Table& table) {
 SlowRecord toSlow(const Table& table) {
   const int it = table.columnIndex("t");
   requireIncreasing(table, it);
+  checkTimeColumn(table.columns[it], "t", table.locator());
+  table.checkStates({"q1", "p1", "q2", "p2"});
   SlowRecord r;
   r.t_s = table.columns[it];
   r.q = slowColumns(table);
@@ -237,6 +253,8 @@ SweepRecord toSweep(const Table& table) {
       throw InputError(table.where(table.row_line[r], io + 1) + "omega0 " +
                        formatDouble(table.columns[io][r]) + " must be > 0 [rad/s]");
   }
+  checkExcitationColumn(table.columns[io], "omega0", table.locator());
+  table.checkStates({"q1", "p1", "q2", "p2"});
   SweepRecord s;
   s.omega0_rad_s = table.columns[io];
   s.q = slowColumns(table);
@@ -261,8 +279,10 @@ RawRecord toRaw(const Table& table, const RecordReadOptions& options) {
   r.source = table.source;
   ExtraColumns extra = extraColumns(table, {m.t, m.f, m.g});
   const size_t n = table.row_line.size();
+  table.checkStates({m.f, m.g});
   if (!options.repair_raw_timestamps) {
     requireIncreasing(table, it);
+    checkTimeColumn(table.columns[it], m.t, table.locator());
     r.t_s = table.columns[it];
     r.f = table.columns[jf];
     r.g = table.columns[jg];
@@ -279,21 +299,27 @@ RawRecord toRaw(const Table& table, const RecordReadOptions& options) {
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return t[a] < t[b]; });
   for (auto& kv : extra) r.extra[kv.first].reserve(n);
+  std::vector<size_t> kept;  // table row of each kept sample
   for (size_t k = 0; k < n; ++k) {
     const size_t i = order[k];
     if (!r.t_s.empty() && t[i] == r.t_s.back()) {
       ++r.n_duplicates_dropped;
       continue;
     }
+    kept.push_back(i);
     r.t_s.push_back(t[i]);
     r.f.push_back(table.columns[jf][i]);
     r.g.push_back(table.columns[jg][i]);
     for (auto& kv : extra) r.extra[kv.first].push_back(kv.second[i]);
   }
+  const RowLocator by_table_row = table.locator();
+  checkTimeColumn(r.t_s, m.t,
+                  [&](size_t k, const std::string& c) { return by_table_row(kept[k], c); });
   return r;
 }
 
 std::string readFile(const std::string& path) {
+  requireInputFile(path, "input record");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open for reading");
   std::ostringstream ss;
@@ -351,6 +377,7 @@ void appendCells(std::string& line, std::initializer_list<double> v) {
 
 template <typename Rec, typename Writer>
 void writeFile(const Rec& record, const std::string& path, Writer writer) {
+  requireOutputFile(path, "output record");
   std::ofstream out(path);
   if (!out) throw InputError(path + ": cannot open for writing");
   writer(record, out);

@@ -4,14 +4,15 @@
 #include <cstring>
 #include <sstream>
 
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/estimate/internal/simd_vector4.h"
+#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 
 std::map<std::string, uint64_t> SampleCounters::asMap() const {
   return {{"accepted", accepted},
           {"non_finite", non_finite},
+          {"out_of_range", out_of_range},
           {"duplicate_timestamp", duplicate_timestamp},
           {"non_monotonic", non_monotonic},
           {"off_grid", off_grid},
@@ -31,6 +32,7 @@ std::vector<std::string> SampleValidatorOptions::validate() const {
   if (!(interval_tolerance > 0.0 && interval_tolerance < 0.5))
     p.push_back("interval_tolerance must be in (0, 0.5)");
   if (!(gap_periods >= 2.0) || !std::isfinite(gap_periods)) p.push_back("gap_periods must be >= 2");
+  if (!(max_abs_signal > 0.0)) p.push_back("max_abs_signal must be > 0");
   return p;
 }
 
@@ -48,6 +50,7 @@ SampleValidator::SampleValidator(const SampleValidatorOptions& options) : option
 
 void SampleValidator::reset() {
   has_last_ = false;
+  restart_pending_ = false;
 }
 
 namespace {
@@ -60,21 +63,24 @@ using M4 = long long __attribute__((vector_size(32)));
 /// time and branch-free, so that the clean batches of a running bench cost well under 1 ns each.
 CVG_HOT_CLONES
 size_t countIrregular(const double* t, const double* f, const double* g, size_t n, double dt,
-                      double tol) {
+                      double tol, double max_abs) {
   M4 bad4 = {0, 0, 0, 0};
   const V4 dt4 = {dt, dt, dt, dt}, tol4 = {tol, tol, tol, tol}, zero = {0.0, 0.0, 0.0, 0.0};
+  const V4 max4 = {max_abs, max_abs, max_abs, max_abs};
   size_t i = 1;
   for (; i + 4 <= n; i += 4) {
     const V4 d = load4(t + i) - load4(t + i - 1) - dt4;
     const V4 fv = load4(f + i), gv = load4(g + i);
     // x - x == 0 exactly when x is finite; |d - dt| <= tol also fails for a NaN/Inf time.
-    const M4 ok = ((fv - fv) == zero) & ((gv - gv) == zero) & (d <= tol4) & (-d <= tol4);
+    const M4 ok = ((fv - fv) == zero) & ((gv - gv) == zero) & (d <= tol4) & (-d <= tol4) &
+                  (fv <= max4) & (-fv <= max4) & (gv <= max4) & (-gv <= max4);
     bad4 += ok + 1;  // ok is -1 (true) or 0
   }
   size_t bad = static_cast<size_t>(bad4[0] + bad4[1] + bad4[2] + bad4[3]);
   for (; i < n; ++i) {
     const double d = t[i] - t[i - 1];
-    bad += !(std::isfinite(f[i]) && std::isfinite(g[i]) && std::fabs(d - dt) <= tol);
+    bad += !(std::isfinite(f[i]) && std::isfinite(g[i]) && std::fabs(d - dt) <= tol &&
+             std::fabs(f[i]) <= max_abs && std::fabs(g[i]) <= max_abs);
   }
   return bad;
 }
@@ -89,9 +95,12 @@ std::vector<AcceptedRun> SampleValidator::screen(const double* t, const double* 
     return runs;
   }
   // Fast path: the whole batch is finite, on the grid, and starts the stream or continues it.
+  const double max_abs = options_.max_abs_signal;
   const bool first_ok = std::isfinite(t[0]) && std::isfinite(f[0]) && std::isfinite(g[0]) &&
+                        std::fabs(f[0]) <= max_abs && std::fabs(g[0]) <= max_abs &&
+                        !restart_pending_ &&
                         (!has_last_ || std::fabs(t[0] - last_t_ - dt_) <= tol_);
-  if (first_ok && countIrregular(t, f, g, n, dt_, tol_) == 0) {
+  if (first_ok && countIrregular(t, f, g, n, dt_, tol_, max_abs) == 0) {
     runs.push_back({0, n, has_last_ ? RunStart::kContinue : RunStart::kRestartFirst, 0, 0.0});
     counters_.accepted += n;
     has_last_ = true;
@@ -121,10 +130,20 @@ std::vector<AcceptedRun> SampleValidator::screen(const double* t, const double* 
       open = false;
       continue;
     }
+    if (std::fabs(f[i]) > max_abs || std::fabs(g[i]) > max_abs) {
+      ++counters_.out_of_range;
+      restart_pending_ = true;
+      open = false;
+      continue;
+    }
     AcceptedRun next;
     next.begin = i;
     if (!has_last_) {
       next.start = RunStart::kRestartFirst;
+      restart_pending_ = false;
+    } else if (restart_pending_ && ti - last_t_ > tol_) {
+      next.start = RunStart::kRestartBad;
+      restart_pending_ = false;
     } else {
       const double d = ti - last_t_;
       if (std::abs(d - dt_) <= tol_) {

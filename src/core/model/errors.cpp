@@ -22,4 +22,11 @@ void requirePositive(double v, const std::string& what) {
   }
 }
 
+void throwIfInvalid(const std::string& what, const std::vector<std::string>& problems) {
+  if (problems.empty()) return;
+  std::string message = what + ":";
+  for (const auto& p : problems) message += " " + p + ";";
+  throw InputError(message);
+}
+
 }  // namespace cvg_bench

@@ -12,7 +12,7 @@ const std::vector<std::pair<std::string, std::function<ModelTermPtr()>>>& regist
       {"linear", makeLinearDefectTerm},       {"controls", makeControlTerm},
       {"xi", makeCubicStiffnessTerm},         {"kappa", makeQuinticStiffnessTerm},
       {"gamma_nl", makeNonlinearDampingTerm}, {"cm_rate", makeFrequencyDriftTerm},
-      {"xi_diff", makeAxisCubicMismatchTerm},
+      {"xi_diff", makeAxisCubicMismatchTerm}, {"xi_k", makeAngularMomentumCubicTerm},
   };
   return r;
 }

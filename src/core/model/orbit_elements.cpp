@@ -79,9 +79,22 @@ double driftRate(double r, double k, double theta, const ParameterValues& p) {
     throw InputError("drift rate (5.9) is undefined for r^2 = k^2 (travelling wave or no wave)");
   const DefectAxes ax = defectAxes(p);
   const double nu = value(p, "nu"), xi = value(p, "xi"), kappa = value(p, "kappa");
-  return -0.25 * nu + xi / 8.0 * r * k + kappa / 8.0 * r * k * (r2 + k2) -
+  // xi_k (the second cubic invariant, docs/paper.md "The second cubic invariant") only turns the
+  // pattern: it adds xi_k r k / 8 here and nothing to (5.7), (5.8), (5.10).
+  const double xi_k = value(p, "xi_k");
+  return -0.25 * nu + (xi + xi_k) / 8.0 * r * k + kappa / 8.0 * r * k * (r2 + k2) -
          r * k / (2 * (r2 - k2)) * ax.h_m * std::cos(4 * (theta - ax.alpha)) +
          (r2 + k2) / (4 * (r2 - k2)) * ax.b_m * std::sin(4 * (theta - ax.beta));
+}
+
+std::vector<double> thetaGrid(long n) {
+  if (n < 1 || n > kMaxThetaGridPoints)
+    throw InputError("a theta grid needs 1.." + std::to_string(kMaxThetaGridPoints) +
+                     " points, got " + std::to_string(n));
+  std::vector<double> thetas;
+  thetas.reserve(n);
+  for (long i = 0; i < n; ++i) thetas.push_back(M_PI / 2 * i / n);
+  return thetas;
 }
 
 }  // namespace cvg_bench

@@ -39,30 +39,57 @@ ResonatorModel::ResonatorModel(const std::string& spec, ExperimentMode mode) : m
     parts.push_back(item);
   }
   if (parts.empty()) throw InputError("empty model specification");
+  // getline drops a trailing empty item: "xi+" must fail like "xi++kappa".
+  const auto last = spec.find_last_not_of(" \t");
+  if (spec[last] == '+') throw InputError("empty term at the end of model '" + spec + "'");
+  addTerms(parts, spec);
+}
+
+ResonatorModel::ResonatorModel(const std::vector<std::string>& extensions, ExperimentMode mode)
+    : mode_(mode) {
+  std::string spec = "linear";
+  for (const auto& e : extensions) spec += "+" + e;  // for the messages only
+  addTerms(extensions, spec);
+}
+
+const std::string& ResonatorModel::muName() {
+  static const std::string name = "mu";
+  return name;
+}
+
+ResonatorModel ResonatorModel::linearPart() const {
+  std::vector<std::string> linear;
+  for (const auto& e : extensions_)
+    if (e != muName()) linear.push_back(e);
+  return ResonatorModel(linear, mode_);
+}
+
+void ResonatorModel::addTerms(const std::vector<std::string>& parts, const std::string& spec) {
   terms_.push_back(makeModelTerm("linear"));
-  if (mode == ExperimentMode::kForced) terms_.push_back(makeModelTerm("controls"));
+  if (mode_ == ExperimentMode::kForced) terms_.push_back(makeModelTerm("controls"));
   for (const auto& p : parts) {
     if (p == "linear") continue;
     if (p == "controls") {
-      if (mode != ExperimentMode::kForced)
+      if (mode_ != ExperimentMode::kForced)
         throw InputError("term 'controls' exists only in forced mode");
       continue;
     }
-    if (p == "mu") {
-      if (mode != ExperimentMode::kForced)
+    if (p == muName()) {
+      if (mode_ != ExperimentMode::kForced)
         throw InputError("term 'mu' (control nonlinearity) exists only in forced mode");
       if (std::find(extensions_.begin(), extensions_.end(), p) != extensions_.end())
         throw InputError("term 'mu' given twice in model '" + spec + "'");
       // mu is bilinear with u~ (3.2): it is not a linear column; estimators handle it (Ceres) and
       // the model carries it as an extension name only.
       extensions_.push_back(p);
+      estimates_mu_ = true;
       continue;
     }
     if (std::find(extensions_.begin(), extensions_.end(), p) != extensions_.end())
       throw InputError("term '" + p + "' given twice in model '" + spec + "'");
     auto term = makeModelTerm(p);
-    if (!term->appliesTo(mode))
-      throw InputError("term '" + p + "' does not apply to " + experimentModeName(mode) + " data");
+    if (!term->appliesTo(mode_))
+      throw InputError("term '" + p + "' does not apply to " + experimentModeName(mode_) + " data");
     extensions_.push_back(p);
     terms_.push_back(term);
   }
@@ -154,7 +181,7 @@ Eigen::VectorXd ResonatorModel::parameterVector(const ParameterValues& values, b
     const int i = indexOf(kv.first);
     if (i >= 0) {
       z[i] = kv.second;
-    } else if (strict && kv.first != "mu") {
+    } else if (strict && kv.first != muName()) {
       throw InputError("parameter '" + kv.first + "' is not part of model " + spec());
     }
   }

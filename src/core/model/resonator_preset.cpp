@@ -11,6 +11,7 @@
 #include <set>
 
 #include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/package_resources.h"
 
 namespace cvg_bench {
 namespace {
@@ -308,10 +309,9 @@ ResonatorPreset loadResonatorPresetFile(const std::string& path) {
 std::string presetDirectory() {
   namespace fs = std::filesystem;
   if (const char* env = std::getenv("CVG_BENCH_PRESET_DIR")) return env;
-  // The source tree CMake compiled this library from (not __FILE__: a compiler cache may make it
-  // relative).
-  const fs::path in_tree = fs::path(CVG_BENCH_SOURCE_DIR) / "config" / "resonators";
-  if (fs::is_directory(in_tree)) return in_tree.string();
+  // The installed or source package (package_resources.h).
+  const std::string shipped = findPackageResource("config/resonators");
+  if (!shipped.empty()) return shipped;
   return (fs::current_path() / "config" / "resonators").string();
 }
 

@@ -13,9 +13,9 @@
 #include <random>
 
 #include "cvg_bench/core/demod/demodulator_noise.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/estimate/identification.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
+#include "cvg_bench/core/model/errors.h"
 #include "identification_test_support.h"
 #include "paper_section4_estimate.h"
 
@@ -182,7 +182,8 @@ TEST(CeresRefinement, NoiselessForcedSweepGivesTruth) {
 }
 
 TEST(CeresRefinement, NoisyForcedSweepTruthInsideIntervals) {
-  // sigma_q = 3e-2: the equation-error LS is biased by ~-15 % in gamma here (docs/paper.md item 15).
+  // sigma_q = 3e-2: the equation-error LS is biased by ~-15 % in gamma here
+  // (docs/paper.md item 15).
   const SweepRecord record = forcedSweep("xi", kForcedTruth, 0.0, 3e-2, 11);
   const Estimate e = refineWithCeres(
       record, startEstimate("xi", ExperimentMode::kForced, kForcedTruth, 0.1), familyWise(13));
@@ -260,7 +261,7 @@ TEST(CeresRefinement, BadInputIsAnInputError) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Monte Carlo validation (issue 4 item 9), DISABLED by default (about a minute); run with
+// Monte Carlo validation of the intervals, DISABLED by default (about a minute); run with
 //   cvg_core_tests --gtest_also_run_disabled_tests --gtest_filter='*MonteCarlo*'
 // (scripts/validate_identification.py does, and writes docs/validation.md). Runs per case:
 // CVG_MC_RUNS (default 200). Prints one `MC ...` line per figure.

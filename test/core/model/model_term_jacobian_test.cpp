@@ -100,7 +100,8 @@ TEST(ModelTermJacobian, DefaultIsCentralDifferences) {
 TEST(ModelTermJacobian, ModelJacobiansMatchFiniteDifferences) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.2, 1.2);
-  const ResonatorModel free_decay("xi+kappa+gamma_nl+cm_rate+xi_diff", ExperimentMode::kFreeDecay);
+  const ResonatorModel free_decay("xi+kappa+gamma_nl+cm_rate+xi_diff+xi_k",
+                                  ExperimentMode::kFreeDecay);
   const ResonatorModel forced("xi+kappa", ExperimentMode::kForced);
   for (const ResonatorModel* model : {&free_decay, &forced}) {
     for (int trial = 0; trial < 10; ++trial) {

@@ -31,10 +31,10 @@ Eigen::Vector4d orbitVector(const Eigen::Vector4d& q) {
 }
 
 TEST(OrbitElements, OrbitRatesEqualAveragedModelThroughChainRule) {
-  const ParameterValues p = {{"gamma", 0.9}, {"nu", 0.4},    {"b_c", 0.3},  {"b_s", -0.2},
-                             {"c_m", 0.7},   {"n", 0.25},    {"h_c", -0.5}, {"h_s", 0.35},
-                             {"xi", 1.3},    {"kappa", -0.6}};
-  const ResonatorModel model("xi+kappa", ExperimentMode::kFreeDecay);
+  const ParameterValues p = {{"gamma", 0.9}, {"nu", 0.4},     {"b_c", 0.3},  {"b_s", -0.2},
+                             {"c_m", 0.7},   {"n", 0.25},     {"h_c", -0.5}, {"h_s", 0.35},
+                             {"xi", 1.3},    {"kappa", -0.6}, {"xi_k", -2.1}};
+  const ResonatorModel model("xi+kappa+xi_k", ExperimentMode::kFreeDecay);
   const Eigen::VectorXd z = model.parameterVector(p);
   std::mt19937 rng(13);
   std::uniform_real_distribution<double> u(-1, 1);
@@ -55,6 +55,19 @@ TEST(OrbitElements, OrbitRatesEqualAveragedModelThroughChainRule) {
 TEST(OrbitElements, DriftRejectsTravellingWaveAndNonFiniteInput) {
   EXPECT_THROW(driftRate(1.0, 1.0, 0.0, {{"nu", 1.0}}), InputError);
   EXPECT_THROW(driftRate(NAN, 0.0, 0.0, {}), InputError);
+}
+
+// xi_k only turns the pattern: theta' gains xi_k r k / 8, and r', k', chi' do not change.
+TEST(OrbitElements, SecondCubicInvariantOnlyTurnsThePattern) {
+  const OrbitElements e{1.2, 0.3, 0.1, 0.4};
+  const ParameterValues base = {{"gamma", 0.2}, {"xi", 1.5}, {"h_c", 0.1}};
+  ParameterValues with = base;
+  with["xi_k"] = 4.0;
+  const OrbitRates a = orbitRates(e, base), b = orbitRates(e, with);
+  EXPECT_NEAR(b.theta_dot - a.theta_dot, 4.0 * 1.2 * 0.3 / 8.0, 1e-14);
+  EXPECT_DOUBLE_EQ(b.r_dot, a.r_dot);
+  EXPECT_DOUBLE_EQ(b.k_dot, a.k_dot);
+  EXPECT_DOUBLE_EQ(b.chi_dot, a.chi_dot);
 }
 
 // A pure standing wave (k = 0) drifts at -nu/4 plus the damping-anisotropy term only.

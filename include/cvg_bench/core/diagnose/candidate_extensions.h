@@ -23,7 +23,7 @@ struct CandidateExtension {
 };
 
 /// The candidates that apply to the mode, in a fixed order:
-///   free decay: xi, kappa, gamma_nl, cm_rate, xi_diff;
+///   free decay: xi, kappa, gamma_nl, cm_rate, xi_diff, xi_k;
 ///   forced:     xi, kappa, mu, gamma_nl, xi_diff.
 std::vector<CandidateExtension> candidateExtensions(ExperimentMode mode);
 

@@ -3,18 +3,20 @@
 // response, Fig. 2; cubic stiffness removes it, Fig. 3, residual std 0.295 -> 0.0926).
 //
 // Steps: (1) fit the linear baseline and read its residual signature (residual_signature.h);
-// (2) forward selection over the candidate extensions (forward_selection.h) with the gain of
-// every step; (3) lack-of-fit test of the final model:
+// (2) best-subset selection over the candidate extensions (forward_selection.h) with the gain of
+// every step and the runner-up; (3) lack-of-fit test of the final model, its residuals whitened
+// by the noise model of residual_noise_model.h (known demodulator correlation or AR(1)):
 //   forced sweep: Wald-Wolfowitz runs test of the per-point residuals ordered by drive frequency
 //     (points do not share samples, so they are independent under an adequate model), on the
 //     radial and tangential projections and the 4 components, Bonferroni over the 6 sequences;
 //   free decay: the same runs test on the output-error (trajectory) residuals q_measured - q_model
-//     (z of the output-error fit, initial state refitted): docs/paper.md item 10, the equation errors
-//     of (2.8) share samples, so a whiteness test on them flags clean data; the trajectory
+//     (z of the output-error fit, initial state refitted): docs/paper.md item 10, the equation
+//     errors of (2.8) share samples, so a whiteness test on them flags clean data; the trajectory
 //     residuals are the measurement noise itself under an adequate model. Decimated to ~200
 //     values per sequence;
 // (4) the verdict in words: cause, parameter with CI, gain; `unexplained` when the final model
-// still fails the lack-of-fit test or keeps a significant residual signature.
+// still fails the lack-of-fit test or keeps a significant residual signature (of the whitened
+// equation residuals).
 // The ROS identifier node's Explain service and the tool's `explain` subcommand both call
 // explainFreeDecay / explainForced.
 #pragma once
@@ -24,8 +26,9 @@
 
 #include "cvg_bench/core/diagnose/forward_selection.h"
 #include "cvg_bench/core/diagnose/nested_model_fitters.h"
-#include "cvg_bench/core/io/records.h"
+#include "cvg_bench/core/diagnose/residual_noise_model.h"
 #include "cvg_bench/core/diagnose/residual_signature.h"
+#include "cvg_bench/core/io/records.h"
 
 namespace cvg_bench {
 
@@ -48,9 +51,11 @@ struct ExplainOptions {
 };
 
 struct LackOfFit {
-  std::string test;      ///< what was tested, in words
-  double p_value = 1.0;  ///< Bonferroni-combined p-value
-  std::string worst;     ///< the sequence with the fewest runs relative to expectation
+  std::string test;         ///< what was tested, in words
+  double p_value = 1.0;     ///< Bonferroni-combined p-value (residuals whitened by the noise model)
+  std::string worst;        ///< the sequence with the fewest runs relative to expectation
+  std::string noise_model;  ///< the whitening noise model, in words
+  double p_value_unwhitened = 1.0;  ///< the same test on the raw residuals (for comparison)
 };
 
 struct Explanation {
@@ -59,11 +64,12 @@ struct Explanation {
   std::vector<BlockResidual> baseline_blocks;  ///< residual blocks of the linear model
   std::vector<BlockResidual> final_blocks;     ///< of the final model
   ResidualSignature baseline_signature;
-  ResidualSignature final_signature;
-  LackOfFit lack_of_fit;           ///< of the final model
-  bool unexplained = false;        ///< structure remains that no accepted extension removes
-  std::string cause;               ///< the verdict in words
-  std::vector<std::string> notes;  ///< provenance and skipped candidates
+  ResidualSignature final_signature;  ///< of the whitened final residuals
+  ResidualNoiseModel noise_model;     ///< under which the adequacy is tested
+  LackOfFit lack_of_fit;              ///< of the final model
+  bool unexplained = false;           ///< structure remains that no accepted extension removes
+  std::string cause;                  ///< the verdict in words
+  std::vector<std::string> notes;     ///< provenance and skipped candidates
   const Estimate& finalEstimate() const { return selection.final_fit.estimate; }
 };
 

@@ -1,5 +1,5 @@
 // NestedModelFitter implementations for the two experiment modes, all fitting through the
-// identification API (identification.h, ceres_refinement.h) and the model's own trajectory /
+// identification pipeline (identify_pipeline.h) and the model's own trajectory /
 // stationary solvers; no equation of the model is written here.
 //
 // Free decay: fit = buildFreeDecaySystem + estimateFromSystem (LS with the honest lag-2 sandwich);
@@ -15,8 +15,8 @@
 
 #include <memory>
 
-#include "cvg_bench/core/estimate/ceres_refinement.h"
 #include "cvg_bench/core/diagnose/forward_selection.h"
+#include "cvg_bench/core/estimate/ceres_refinement.h"
 #include "cvg_bench/core/estimate/identification.h"
 #include "cvg_bench/core/io/records.h"
 
@@ -41,8 +41,5 @@ std::unique_ptr<NestedModelFitter> makeFreeDecayFitter(const SlowRecord& record,
                                                        const NestedFitterOptions& options);
 std::unique_ptr<NestedModelFitter> makeForcedFitter(const SweepRecord& record,
                                                     const NestedFitterOptions& options);
-
-/// "linear+a+b" from extension names ("linear" when empty).
-std::string modelSpecOf(const std::vector<std::string>& extensions);
 
 }  // namespace cvg_bench

@@ -40,4 +40,16 @@ std::map<std::string, ParameterEstimate> deriveQuantitiesWithIntervals(const Unc
 ParameterEstimate driftRateWithInterval(double r, double k, double theta,
                                         const UncertainParameters& p);
 
+/// Q = omega / rate from a decay rate with its variance (e.g. the envelope rate c'z, variance
+/// c' cov c): interval from the rate's Student-t interval mapped through omega / rate (asymmetric),
+/// std by the delta method. InputError when the rate is not positive.
+ParameterEstimate qualityFactorFromRate(double omega_rad_s, double rate, double rate_variance,
+                                        double confidence, int dof);
+
+/// The section-4 quantities of e with intervals, from its well-identified combinations: when gamma
+/// is not identified (e.not_identified) and e.envelope_coefficients exist, "Q" is the envelope's
+/// Q (and derived_method says so); "Q_envelope" is added whenever the envelope exists. Fills
+/// e->derived, e->derived_method and notes; nothing when omega <= 0 or the rank is deficient.
+void deriveFromIdentified(Estimate* e, double omega_rad_s, double angular_gain_k);
+
 }  // namespace cvg_bench

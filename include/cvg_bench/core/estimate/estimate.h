@@ -3,6 +3,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -21,6 +23,17 @@ struct ParameterEstimate {
   double ci_high = 0.0;    ///< value + s_p * std_error
 };
 
+/// value +- s_p x standard error with standard error sqrt(variance) (a variance below 0 from
+/// rounding counts as 0): the interval form of (2.11), s_p the quantile of the chosen distribution.
+inline ParameterEstimate interval(double value, double variance, double s_p) {
+  ParameterEstimate p;
+  p.value = value;
+  p.std_error = std::sqrt(std::max(0.0, variance));
+  p.ci_low = value - s_p * p.std_error;
+  p.ci_high = value + s_p * p.std_error;
+  return p;
+}
+
 struct Estimate {
   ExperimentMode mode = ExperimentMode::kFreeDecay;
   std::string model;         ///< canonical spec, e.g. "linear+xi"
@@ -33,11 +46,11 @@ struct Estimate {
   /// Parameters (or combinations, written as e.g. "gamma+b_c") the data cannot separate.
   std::vector<std::string> unidentifiable;
   std::string identifiability_note;  ///< why, in words (empty when full rank)
-  double sigma = 0.0;                ///< sigma-hat (2.10), in equation units (docs/paper.md item 14)
-  double confidence = 0.95;          ///< P0 of (2.11)
-  std::vector<std::string> names;    ///< parameter names in z order
-  Eigen::VectorXd values;            ///< z-hat
-  Eigen::MatrixXd covariance;        ///< covariance of z-hat (row-major order = names order)
+  double sigma = 0.0;              ///< sigma-hat (2.10), in equation units (docs/paper.md item 14)
+  double confidence = 0.95;        ///< P0 of (2.11)
+  std::vector<std::string> names;  ///< parameter names in z order
+  Eigen::VectorXd values;          ///< z-hat
+  Eigen::MatrixXd covariance;      ///< covariance of z-hat (row-major order = names order)
   std::map<std::string, ParameterEstimate> parameters;  ///< by name
   std::map<std::string, ParameterEstimate> derived;     ///< section-4 quantities with CIs
   std::vector<std::string> notes;  ///< provenance: e.g. "demodulated raw f,g at omega = ..."
@@ -57,6 +70,29 @@ struct Estimate {
   /// Singular values of the column-equilibrated regression matrix, descending.
   std::vector<double> singular_values;
   double rank_tolerance = 0.0;  ///< relative singular-value tolerance used for `rank`
+
+  // ---- serial correlation of the residuals and the method of the intervals
+  /// Short name of the method behind `parameters`: "eiv_white", "eiv_ar1", "demod_correlation",
+  /// "cluster_sandwich", "hac_bartlett_andrews", "iid", "paper_2_11" (empty: not set).
+  std::string interval_method_id;
+  double residual_lag1 = 0.0;           ///< lag-1 correlation of the residuals (one time step)
+  double residual_lag1_expected = 0.0;  ///< its value under independent noise
+  double residual_lag1_z = 0.0;         ///< the test statistic (residual_correlation.h)
+  bool residual_correlated = false;     ///< |z| > 2.576: the intervals account for it
+  std::string noise_model;              ///< e.g. "AR(1) rho = 0.9 (fitted)"
+
+  // ---- near-collinear identifiability (collinearity.h)
+  std::map<std::string, double> vif;  ///< variance-inflation factor per parameter
+  double condition_number = 0.0;      ///< of the column-normalized Jacobian (0: not computed)
+  /// Weakly identified directions: text (column-normalized coefficients) and singular value.
+  std::vector<std::pair<std::string, double>> weak_directions;
+  /// Parameters the record does not identify (VIF >= 1e4), reported with `combinations`.
+  std::vector<std::string> not_identified;
+  /// How a derived quantity was obtained where it is not the plain section-4 formula.
+  std::map<std::string, std::string> derived_method;
+  /// Free decay: c with c'z = the envelope decay rate gamma_env of the record (Q = omega /
+  /// gamma_env), in `names` order; empty otherwise.
+  Eigen::VectorXd envelope_coefficients;
 };
 
 }  // namespace cvg_bench

@@ -1,6 +1,6 @@
-// The honest covariance of the free-decay regression (2.7)-(2.8) (docs/paper.md item 10): neighbouring
-// equations share samples, and the noisy samples enter both y and D-bar. Linearized in white sample
-// noise eps_m (covariance sigma_q^2 I), the equation errors are
+// The honest covariance of the free-decay regression (2.7)-(2.8) (docs/paper.md item 10):
+// neighbouring equations share samples, and the noisy samples enter both y and D-bar. Linearized in
+// white sample noise eps_m (covariance sigma_q^2 I), the equation errors are
 //   e_i = sum_m A_im eps_m,  A_i,i+1 = 2 I - w_i,i+1 G_i+1,  A_i,i = -w_ii G_i,
 //   A_i,i-1 = -2 I - w_i,i-1 G_i-1,  G = d(D(q) z)/dq (ResonatorModel::regressorJacobian),
 // w the quadrature weights of D-bar_i, so D' Omega D = sigma_q^2 sum_m W_m W_m' with
@@ -11,9 +11,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 
-#include "cvg_bench/core/estimate/internal/block_gram_accumulator.h"
 #include "cvg_bench/core/estimate/free_decay_regression.h"
+#include "cvg_bench/core/estimate/internal/block_gram_accumulator.h"
 
 namespace cvg_bench {
 
@@ -27,6 +28,10 @@ class FreeDecayNoisePropagation {
   Eigen::MatrixXd sensitivityGram() { return gram_.sum(); }
   /// sum over equations i and samples m of ||A_im||_F^2.
   double noiseGain() const { return noise_gain_; }
+  /// Called with W_m' (4 x k) of every finished sample in time order; first: the record's first
+  /// (for correlated noise, correlated_noise_gram.h).
+  using SampleSink = std::function<void(const RegressionBlockMatrix&, bool first)>;
+  void setSampleSink(SampleSink sink) { sink_ = std::move(sink); }
 
  private:
   /// U_m, V_m (4 x k, column-major) and the sums of s^2, s w, w^2 over the sample's blocks.
@@ -46,6 +51,8 @@ class FreeDecayNoisePropagation {
   RegressionBlockMatrix w_;  // W_m' of the sample being finished
   SlowContext ctx_;
   double noise_gain_ = 0.0;
+  SampleSink sink_;
+  bool next_first_ = true;
 };
 
 }  // namespace cvg_bench

@@ -38,4 +38,11 @@ HacCovariance hacCovariance(const Eigen::MatrixXd& jacobian, const Eigen::Vector
 HacCovariance hacCovarianceBlocked(const Eigen::MatrixXd& jacobian,
                                    const Eigen::VectorXd& residuals, int block_size, int lag = -1);
 
+/// The same from the per-time-step scores g_t = J_t' e_t (nb x p rows in time order, parameter
+/// units) of a system whose QR factor R (J'J = R'R) has the pseudo-inverse r_pinv (p x p), for
+/// estimators that stream J (identification.cpp): n_rows and rank give the small-sample factor.
+/// rho1 and variance_inflation are left at their defaults.
+HacCovariance hacCovarianceFromScores(const Eigen::MatrixXd& scores, const Eigen::MatrixXd& r_pinv,
+                                      long n_rows, int rank, int lag = -1);
+
 }  // namespace cvg_bench

@@ -6,6 +6,8 @@
 // With dt = 1 / sample_rate_hz and d = t - t_last (t_last = last accepted timestamp), tol =
 // interval_tolerance * dt, a sample is:
 //   non_finite            t, f or g NaN/Inf                                   -> dropped
+//   out_of_range          |f| or |g| > max_abs_signal (a corrupted sample)    -> dropped, and the
+//                         next accepted sample RESTARTS the filter (state cleared)
 //   duplicate_timestamp   |d| <= tol                                          -> dropped
 //   non_monotonic         -gap_periods * dt <= d < -tol (out-of-order sample) -> dropped
 //   backward jump         d < -gap_periods * dt (bag loop, clock reset)       -> RESET, kept
@@ -31,6 +33,7 @@ namespace cvg_bench {
 struct SampleCounters {
   uint64_t accepted = 0;               ///< samples passed to the filter
   uint64_t non_finite = 0;             ///< t, f or g NaN/Inf
+  uint64_t out_of_range = 0;           ///< |f| or |g| above max_abs_signal
   uint64_t duplicate_timestamp = 0;    ///< same timestamp as the previous accepted sample
   uint64_t non_monotonic = 0;          ///< small step back in time (out-of-order sample)
   uint64_t off_grid = 0;               ///< interval not a whole number of sample periods
@@ -44,7 +47,8 @@ struct SampleCounters {
 
   /// Total samples dropped (not passed to the filter).
   uint64_t rejected() const {
-    return non_finite + duplicate_timestamp + non_monotonic + off_grid + rate_mismatch_samples;
+    return non_finite + out_of_range + duplicate_timestamp + non_monotonic + off_grid +
+           rate_mismatch_samples;
   }
   /// name -> count, for diagnostics.
   std::map<std::string, uint64_t> asMap() const;
@@ -59,6 +63,8 @@ struct SampleValidatorOptions {
   /// k: an interval longer than k sample periods is a gap (filter restart); a backward jump by
   /// more than k periods resets the demodulator. >= 2.
   double gap_periods = 10.0;
+  /// Largest accepted |f|, |g| [signal units]; a larger sample is a corrupted one (> 0).
+  double max_abs_signal = 1e30;
 
   std::vector<std::string> validate() const;
 };
@@ -69,6 +75,7 @@ enum class RunStart {
   kFillMissing,   ///< `missing` samples are absent between the previous accepted sample and it
   kRestartFirst,  ///< first sample since construction/reset
   kRestartGap,    ///< after a gap longer than gap_periods
+  kRestartBad,    ///< after a dropped out-of-range sample: the filter state is cleared
   kResetBackward  ///< after a large jump back in time
 };
 
@@ -100,6 +107,7 @@ class SampleValidator {
   double lastTime() const { return last_t_; }
 
  private:
+  bool restart_pending_ = false;  ///< an out-of-range sample was dropped since the last run
   SampleValidatorOptions options_;
   double dt_, tol_;
   SampleCounters counters_;

@@ -6,6 +6,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace cvg_bench {
 
@@ -23,5 +24,8 @@ class AnalysisError : public std::runtime_error {
 void requireFinite(double v, const std::string& what);
 /// Throws InputError unless v is finite and > 0.
 void requirePositive(double v, const std::string& what);
+/// Throws InputError("<what>: <problem 1>; <problem 2>; ...") unless problems is empty (the list an
+/// Options::validate() returns).
+void throwIfInvalid(const std::string& what, const std::vector<std::string>& problems);
 
 }  // namespace cvg_bench

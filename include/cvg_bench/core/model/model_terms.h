@@ -1,6 +1,7 @@
 // Factories of the individual model terms (one file each under src/core/, with its derivation).
 #pragma once
 
+#include "cvg_bench/core/model/angular_momentum_cubic_term.h"  // xi_k
 #include "cvg_bench/core/model/model_term.h"
 
 namespace cvg_bench {

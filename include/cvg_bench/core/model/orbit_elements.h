@@ -1,7 +1,7 @@
 // Orbit elements of section 5: r (main wave amplitude), k (quadrature amplitude), theta (wave
 // pattern angle) and chi (temporal phase), by the change of variables (5.2), and their averaged
-// evolution (5.7)-(5.10) with the corrections of docs/paper.md item 4-5: the nonlinear terms carry the
-// tilde coefficients, and the damping-anisotropy terms depend on (theta - beta).
+// evolution (5.7)-(5.10) with the corrections of docs/paper.md item 4-5: the nonlinear terms carry
+// the tilde coefficients, and the damping-anisotropy terms depend on (theta - beta).
 #pragma once
 
 #include <Eigen/Core>
@@ -41,10 +41,18 @@ struct OrbitRates {
 };
 
 /// (5.7)-(5.10) (corrected) for free oscillation (u = 0) with the paper's terms gamma, nu, b_c,
-/// b_s, c_m, n, h_c, h_s, xi, kappa taken from p (missing ones are 0). Requires r^2 != k^2.
+/// b_s, c_m, n, h_c, h_s, xi, kappa and the second cubic invariant xi_k (theta' only) taken from p
+/// (missing ones are 0). Requires r^2 != k^2.
 OrbitRates orbitRates(const OrbitElements& e, const ParameterValues& p);
 
-/// The drift rate theta' of (5.9) [rad/s] (corrected), the gyro's zero-rate error at (r, k, theta).
+/// The drift rate theta' of (5.9) [rad/s] (corrected; plus xi_k r k / 8), the gyro's zero-rate
+/// error at (r, k, theta).
 double driftRate(double r, double k, double theta, const ParameterValues& p);
+
+/// Most points a pattern-angle grid may have.
+constexpr long kMaxThetaGridPoints = 100000;
+/// n pattern angles theta_i = (pi / 2) i / n, i = 0..n-1, evenly over one period [0, pi/2) of the
+/// drift (5.9) in theta. InputError unless 1 <= n <= kMaxThetaGridPoints.
+std::vector<double> thetaGrid(long n);
 
 }  // namespace cvg_bench

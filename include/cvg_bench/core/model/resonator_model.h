@@ -5,7 +5,7 @@
 // Parameter vector z (regression units, in parameterNames() order):
 //   linear base  gamma, nu, b_c, b_s [1/s]; c_m, n, h_c, h_s [1/s, tilde = coefficient / omega];
 //   forced mode  u1..u4 [1/s x amplitude, tilde = eta u_i / omega];
-//   extensions   xi, kappa, xi_diff [tilde, 1/(s amplitude^2), 1/(s amplitude^4)], gamma_nl
+//   extensions   xi, kappa, xi_diff, xi_k [tilde, 1/(s amplitude^2), 1/(s amplitude^4)], gamma_nl
 //                [1/(s amplitude^2)], cm_rate [1/s^2, tilde].
 // Amplitudes are in the record's units (normalized by the maximum amplitude in the paper's section
 // 4).
@@ -24,7 +24,8 @@ namespace cvg_bench {
 using ParameterValues = std::map<std::string, double>;
 
 /// Detuning rate of the forced averaged equations: exactly (omega0^2 - omega^2) / omega0
-/// = 2 lambda - lambda^2 / (omega + lambda) with lambda = omega0 - omega (docs/paper.md item 7) [rad/s].
+/// = 2 lambda - lambda^2 / (omega + lambda) with lambda = omega0 - omega (docs/paper.md item 7)
+/// [rad/s].
 double detuningRate(double omega_rad_s, double omega0_rad_s);
 
 /// The vector multiplying the detuning rate in (3.2)-(3.3): y / (2 lambda) = (p1, -q1, p2, -q2).
@@ -43,12 +44,22 @@ class ResonatorModel {
   /// is always included, `controls` is added in forced mode). Throws InputError for an unknown
   /// term, a duplicate, or a term that does not apply to the mode (e.g. cm_rate in forced mode).
   ResonatorModel(const std::string& spec, ExperimentMode mode);
+  /// The same from the extension names (empty = `linear`), e.g. a nested model of the selection.
+  ResonatorModel(const std::vector<std::string>& extensions, ExperimentMode mode);
+
+  /// Name of the control nonlinearity of (3.1)-(3.2) in specs and estimates.
+  static const std::string& muName();
 
   ExperimentMode mode() const { return mode_; }
   /// Canonical spec: `linear`, `linear+xi`, `linear+xi+kappa`, ...
   std::string spec() const;
   /// Names of the extension terms in the order given (empty for `linear`).
   const std::vector<std::string>& extensionNames() const { return extensions_; }
+  /// True when the spec holds `mu` (forced mode only): mu multiplies u~ bilinearly in (3.2), so it
+  /// is an unknown of the output-error fit, not a column of D(q) (parameterNames() lacks it).
+  bool estimatesMu() const { return estimates_mu_; }
+  /// The model without `mu`: the part linear in z that least squares can fit.
+  ResonatorModel linearPart() const;
   const std::vector<ModelTermPtr>& terms() const { return terms_; }
   const std::vector<std::string>& parameterNames() const { return names_; }
   int numParameters() const { return static_cast<int>(names_.size()); }
@@ -87,7 +98,10 @@ class ResonatorModel {
   ParameterValues parameterValues(const Eigen::VectorXd& z) const;
 
  private:
+  void addTerms(const std::vector<std::string>& parts, const std::string& spec);
+
   ExperimentMode mode_;
+  bool estimates_mu_ = false;
   std::vector<std::string> extensions_;
   std::vector<ModelTermPtr> terms_;
   std::vector<int> offsets_;

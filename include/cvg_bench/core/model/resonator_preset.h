@@ -90,8 +90,8 @@ std::vector<std::string> effectNames();
 ResonatorPreset loadResonatorPresetFile(const std::string& path);
 /// A shipped preset by name, from presetDirectory().
 ResonatorPreset loadShippedPreset(const std::string& name);
-/// Where shipped presets live: $CVG_BENCH_PRESET_DIR, else the source tree's config/resonators,
-/// else ./config/resonators.
+/// Where shipped presets live: $CVG_BENCH_PRESET_DIR, else config/resonators of the installed or
+/// source package (package_resources.h), else ./config/resonators.
 std::string presetDirectory();
 /// Names (file stems) of the presets in presetDirectory(), sorted.
 std::vector<std::string> shippedPresetNames();

@@ -1,0 +1,43 @@
+// The noise model under which `explain`'s adequacy test is calibrated (issue 11: the lack-of-fit
+// verdict must hold its false-alarm rate on demodulated records and coloured noise).
+//
+// Residuals of an adequate model are the measurement noise; when that noise is correlated, sign
+// runs and signature correlations of the raw residuals look like structure. The residuals are
+// therefore whitened, channel by channel, by an autoregressive filter
+//   w_t = e_t - sum_{k=1..p} a_k e_{t-k}
+// before the runs test and the signature:
+//   known correlation rho_1..rho_L (a demodulated record's noise_correlation): AR(p) by
+//     Levinson-Durbin on rho (p = min(L, 30));
+//   otherwise AR(1) with rho from the variogram ratio
+//     rho = (1 - r_2) / (1 - r_1) - 1,   r_l the lag-l residual autocorrelation,
+//   which a slowly varying misfit s (s_t ~ s_{t-1} ~ s_{t-2}) leaves unchanged, unlike r_1 itself:
+//   a missing effect is not mistaken for correlated noise and whitened away.
+// A smooth misfit passes the filter scaled by (1 - sum a_k), so it stays visible to the tests.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace cvg_bench {
+
+struct ResidualNoiseModel {
+  std::vector<double> ar;  ///< a_1..a_p of the whitening filter (empty: white)
+  double rho1 = 0.0;       ///< lag-1 correlation of the model's noise
+  std::string description;
+};
+
+/// AR(p) of known correlations (Levinson-Durbin), p <= max_order.
+ResidualNoiseModel noiseModelFromCorrelation(const std::vector<double>& rho, int max_order = 30);
+
+/// AR(1) from the variogram ratio of residuals with `channels` interleaved components (row r is
+/// channel r % channels), rho clamped to [-0.5, 0.98]; white when |rho| < min_rho.
+ResidualNoiseModel noiseModelFromResiduals(const Eigen::VectorXd& residuals, int channels,
+                                           double min_rho = 0.05);
+
+/// Applies the whitening filter to each channel (the first p samples of a channel use the
+/// available past only).
+Eigen::VectorXd whiten(const Eigen::VectorXd& residuals, int channels,
+                       const ResidualNoiseModel& model);
+
+}  // namespace cvg_bench

@@ -1,0 +1,58 @@
+// The one identification pipeline: every caller (cvg_ident identify, the identifier node's
+// `identify` service, explain's nested-model fitters) asks for a method and gets the same chain.
+//
+//   kLs     batch equation-error least squares: free decay (2.7)-(2.8), forced sweep (3.4)-(3.5);
+//   kRls    the block recursive least squares (2.12) over the same blocks (corrected pairing);
+//   kCeres  LS start, then the output-error refinement (ceres_refinement.h), which removes the
+//           errors-in-variables bias of the equation-error fit (docs/paper.md item 15).
+//
+// The control nonlinearity mu of (3.1)-(3.2) multiplies u~ bilinearly, so no linear regression
+// estimates it. When the model estimates it (ResonatorModel::estimatesMu, forced mode only), the
+// pipeline solves the linear part by LS at mu = identification.mu (the start value) and lets Ceres
+// estimate z and mu jointly; any other method is an InputError naming the way out.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cvg_bench/core/estimate/ceres_refinement.h"
+#include "cvg_bench/core/estimate/estimate.h"
+#include "cvg_bench/core/estimate/identification.h"
+#include "cvg_bench/core/io/records.h"
+
+namespace cvg_bench {
+
+enum class Method { kLs, kRls, kCeres };
+
+/// "ls" / "rls" / "ceres" <-> Method; InputError for other names.
+Method parseMethod(const std::string& name);
+std::string methodName(Method method);
+
+/// What to do when the Ceres refinement finds no usable solution (AnalysisError).
+enum class CeresFailure {
+  kThrow,     ///< pass the AnalysisError on (the tool reports it)
+  kKeepStart  ///< return the LS start with a note saying why (explain's nested fits)
+};
+
+struct PipelineOptions {
+  Method method = Method::kLs;
+  /// Model, confidence, omega, angular gain, mu, rank tolerance, RLS settings of the regression.
+  /// Its `method` field is set by the pipeline from `method`. `mu` is the known control
+  /// nonlinearity when the model does not estimate mu, else the start value of the Ceres fit.
+  IdentificationOptions identification;
+  /// Solver settings of the output-error refinement (kCeres). Its confidence, angular gain,
+  /// known_mu and mu_start are taken from `identification`, so the two stages agree.
+  CeresOptions ceres;
+  CeresFailure on_ceres_failure = CeresFailure::kThrow;
+
+  /// Every problem with the options (of both stages), empty when valid.
+  std::vector<std::string> validate() const;
+};
+
+/// Free-decay identification of one record. InputError for bad input or options; AnalysisError
+/// when Ceres finds no usable solution and on_ceres_failure is kThrow.
+Estimate identify(const SlowRecord& record, const PipelineOptions& options);
+/// Forced-sweep identification of one sweep record; errors as above.
+Estimate identify(const SweepRecord& record, const PipelineOptions& options);
+
+}  // namespace cvg_bench

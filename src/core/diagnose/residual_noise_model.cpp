@@ -1,0 +1,95 @@
+#include "cvg_bench/core/diagnose/residual_noise_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace cvg_bench {
+namespace {
+
+std::string num(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+ResidualNoiseModel noiseModelFromCorrelation(const std::vector<double>& rho, int max_order) {
+  ResidualNoiseModel m;
+  const int p = std::min<int>(max_order, static_cast<int>(rho.size()));
+  if (p < 1) {
+    m.description = "white (no correlation known)";
+    return m;
+  }
+  // Levinson-Durbin on r_0 = 1, r_1..r_p.
+  std::vector<double> a(p + 1, 0.0), prev(p + 1, 0.0);
+  double err = 1.0;
+  int order = 0;
+  for (int k = 1; k <= p; ++k) {
+    double acc = rho[k - 1];
+    for (int j = 1; j < k; ++j) acc -= prev[j] * rho[k - j - 1];
+    const double refl = acc / err;
+    if (!std::isfinite(refl) || std::abs(refl) >= 1.0) break;
+    a[k] = refl;
+    for (int j = 1; j < k; ++j) a[j] = prev[j] - refl * prev[k - j];
+    err *= (1.0 - refl * refl);
+    prev = a;
+    order = k;
+  }
+  m.ar.assign(prev.begin() + 1, prev.begin() + 1 + order);
+  m.rho1 = rho[0];
+  m.description = "the record's known noise correlation (rho_1 = " + num(rho[0]) + ", " +
+                  std::to_string(rho.size()) + " lags) as AR(" + std::to_string(order) + ")";
+  return m;
+}
+
+ResidualNoiseModel noiseModelFromResiduals(const Eigen::VectorXd& residuals, int channels,
+                                           double min_rho) {
+  ResidualNoiseModel m;
+  channels = std::max(1, channels);
+  const long n = residuals.size() / channels;
+  double c0 = 0.0, c1 = 0.0, c2 = 0.0;
+  for (int c = 0; c < channels && n > 8; ++c) {
+    Eigen::VectorXd x(n);
+    for (long i = 0; i < n; ++i) x[i] = residuals[i * channels + c];
+    x.array() -= x.mean();
+    c0 += x.squaredNorm();
+    c1 += x.head(n - 1).dot(x.tail(n - 1));
+    c2 += x.head(n - 2).dot(x.tail(n - 2));
+  }
+  double rho = 0.0;
+  if (c0 > 0.0) {
+    const double r1 = c1 / c0, r2 = c2 / c0;
+    rho = 1.0 - r1 > 1e-9 ? (1.0 - r2) / (1.0 - r1) - 1.0 : 0.98;
+    rho = std::min(0.98, std::max(-0.5, rho));
+  }
+  if (std::abs(rho) < min_rho) {
+    m.description = "white (variogram-ratio AR(1) estimate rho = " + num(rho) + ")";
+    return m;
+  }
+  m.ar = {rho};
+  m.rho1 = rho;
+  m.description = "AR(1) fitted to the residuals (variogram ratio, rho = " + num(rho) + ")";
+  return m;
+}
+
+Eigen::VectorXd whiten(const Eigen::VectorXd& residuals, int channels,
+                       const ResidualNoiseModel& model) {
+  if (model.ar.empty()) return residuals;
+  channels = std::max(1, channels);
+  const long n = residuals.size() / channels;
+  Eigen::VectorXd w = residuals;
+  for (int c = 0; c < channels; ++c) {
+    for (long i = 0; i < n; ++i) {
+      double v = residuals[i * channels + c];
+      for (size_t k = 1; k <= model.ar.size() && static_cast<long>(k) <= i; ++k)
+        v -= model.ar[k - 1] * residuals[(i - static_cast<long>(k)) * channels + c];
+      w[i * channels + c] = v;
+    }
+  }
+  return w;
+}
+
+}  // namespace cvg_bench

@@ -1,0 +1,434 @@
+// Best-subset selection of model extensions (forward_selection.h has the criterion):
+//   1. every subset of up to max_steps candidates is fitted by the cheap fit (equation-error LS of
+//      (2.8) / (3.4)) and scored by IC with c from the residuals of the whole library's cheap fit;
+//   2. the linear model and the `finalists` best subsets are refined (output-error fit of the
+//      trajectory in free decay, docs/paper.md items 10, 15: the LS of (2.8) carries an
+//      errors-in-variables bias) and scored again, c from the output-error residuals of the largest
+//      finalist (and never below the record's known noise_correlation);
+//   3. the best refined subset is checked backwards (a term goes when the subset without it
+//      scores better) and confirmed on the hold-out: it must predict the held-out data better than
+//      the linear model, else the next subset in criterion order is tried;
+//   4. the steps ladder adds the chosen terms one at a time, best refined criterion first; the
+//      runner-up is the best refined subset not chosen.
+// Subsets act together: cubic + quintic stiffness in a decay are nearly collinear (amplitude^2 and
+// amplitude^4 both fall monotonically), each alone can worsen the hold-out, the pair does not.
+#include <algorithm>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "cvg_bench/core/diagnose/forward_selection.h"
+#include "cvg_bench/core/diagnose/nested_model_fitters.h"
+#include "cvg_bench/core/diagnose/residual_correlation.h"
+#include "cvg_bench/core/model/errors.h"
+
+namespace cvg_bench {
+
+std::vector<std::string> SelectionOptions::validate() const {
+  std::vector<std::string> p;
+  if (!(alpha > 0.0 && alpha < 0.5)) p.push_back("alpha must lie in (0, 0.5)");
+  if (!(min_holdout_ratio >= 0.0) || !std::isfinite(min_holdout_ratio))
+    p.push_back("min_holdout_ratio must be finite and >= 0");
+  if (max_steps < 1 || max_steps > 4) p.push_back("max_steps must lie in 1..4");
+  if (finalists < 1 || finalists > 20) p.push_back("finalists must lie in 1..20");
+  return p;
+}
+
+namespace {
+
+using Terms = std::vector<std::string>;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double ratio(double a, double b) {
+  if (!(b > 0.0)) return a > 0.0 ? kInf : 1.0;
+  return a / b;
+}
+
+std::string key(const Terms& t) {
+  return modelSpecOf(t);
+}
+
+/// All subsets of `names` with up to `max_size` elements, in candidate order, smallest first.
+std::vector<Terms> subsetsUpTo(const std::vector<std::string>& names, int max_size) {
+  std::vector<Terms> out = {{}};
+  for (size_t i = 0; i < out.size(); ++i) {
+    if (static_cast<int>(out[i].size()) >= max_size) continue;
+    size_t start = 0;
+    if (!out[i].empty())
+      start = std::find(names.begin(), names.end(), out[i].back()) - names.begin() + 1;
+    for (size_t j = start; j < names.size(); ++j) {
+      Terms t = out[i];
+      t.push_back(names[j]);
+      out.push_back(t);
+    }
+  }
+  return out;
+}
+
+Terms without(const Terms& t, const std::string& name) {
+  Terms o;
+  for (const auto& x : t)
+    if (x != name) o.push_back(x);
+  return o;
+}
+
+/// The fits, scores and hold-outs of one selection, each computed once.
+class SubsetSearch {
+ public:
+  SubsetSearch(const NestedModelFitter& fitter, const std::vector<CandidateExtension>& candidates,
+               const SelectionOptions& options, std::vector<std::string>* notes)
+      : fitter_(fitter), options_(options), notes_(notes) {
+    for (const auto& c : candidates) names_.push_back(c.name);
+    const boost::math::chi_squared chi2(1);
+    penalty_floor_ = boost::math::quantile(
+        boost::math::complement(chi2, options.alpha / std::max<size_t>(1, candidates.size())));
+  }
+
+  const std::vector<std::string>& names() const { return names_; }
+
+  /// Orders `terms` as the candidates are ordered.
+  Terms canonical(const Terms& terms) const {
+    Terms t;
+    for (const auto& n : names_)
+      if (std::find(terms.begin(), terms.end(), n) != terms.end()) t.push_back(n);
+    return t;
+  }
+
+  const NestedFit* cheap(const Terms& t) { return cached(t, &cheap_, false); }
+  const NestedFit* refined(const Terms& t) {
+    if (!fitter_.refinesByOutputError()) return cheap(t);
+    const NestedFit* f = cached(t, &refined_, true);
+    // A free-decay refinement that fell back to LS has residuals in other units: not comparable.
+    if (f && f->estimate.method != "ceres") return nullptr;
+    return f;
+  }
+
+  double criterion(const NestedFit& f, size_t k, double c) const {
+    const double n = static_cast<double>(f.n_equations);
+    if (!(f.rss > 0.0) || n < 1) return kInf;
+    const double n_eff = n / c;
+    return n_eff * std::log(f.rss / n) + static_cast<double>(k) * penalty(c, n);
+  }
+  double penalty(double c, double n) const {
+    return std::max(std::log(std::max(n / c, 1.0)), penalty_floor_);
+  }
+  double penaltyFloor() const { return penalty_floor_; }
+
+  bool hasHoldout(const Terms& t) const { return holdout_.count(key(t)) > 0; }
+  double holdout(const Terms& t) {
+    const std::string k = key(t);
+    const auto it = holdout_.find(k);
+    if (it != holdout_.end()) return it->second;
+    double h = kInf;
+    try {
+      h = fitter_.holdoutRms(t);
+    } catch (const std::exception& err) {
+      if (notes_) notes_->push_back("hold-out of " + k + " failed: " + err.what());
+    }
+    holdout_[k] = h;
+    return h;
+  }
+
+ private:
+  const NestedFit* cached(const Terms& t, std::map<std::string, NestedFit>* cache, bool refine) {
+    const std::string k = key(t);
+    const auto it = cache->find(k);
+    if (it != cache->end()) return &it->second;
+    if (failed_.count(k + (refine ? "/r" : "/c"))) return nullptr;
+    try {
+      NestedFit f = refine ? fitter_.fit(t) : fitter_.fitEquationError(t);
+      return &cache->emplace(k, std::move(f)).first->second;
+    } catch (const std::exception& err) {
+      failed_[k + (refine ? "/r" : "/c")] = true;
+      if (notes_)
+        notes_->push_back("subset " + k + " skipped (" + (refine ? "refined" : "LS") +
+                          " fit failed): " + err.what());
+      return nullptr;
+    }
+  }
+
+  const NestedModelFitter& fitter_;
+  SelectionOptions options_;
+  std::vector<std::string>* notes_;
+  std::vector<std::string> names_;
+  double penalty_floor_ = 0.0;
+  std::map<std::string, NestedFit> cheap_, refined_;
+  std::map<std::string, double> holdout_;
+  std::map<std::string, bool> failed_;
+};
+
+/// Stacked output-error residuals of a refined fit (4 per sample).
+Eigen::VectorXd adequacyVector(const NestedModelFitter& fitter, const NestedFit& f) {
+  const auto blocks = fitter.adequacyResiduals(f);
+  Eigen::VectorXd r(4 * blocks.size());
+  for (size_t i = 0; i < blocks.size(); ++i) r.segment<4>(4 * i) = blocks[i].e;
+  return r;
+}
+
+std::string num(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+SelectionResult selectExtensions(const NestedModelFitter& fitter,
+                                 const std::vector<CandidateExtension>& candidates,
+                                 const SelectionOptions& options, std::vector<std::string>* notes) {
+  const auto problems = options.validate();
+  if (!problems.empty()) {
+    std::string msg = "invalid selection options:";
+    for (const auto& p : problems) msg += " " + p + ";";
+    throw InputError(msg);
+  }
+  SubsetSearch search(fitter, candidates, options, notes);
+  SelectionResult result;
+  result.holdout_description = fitter.holdoutDescription();
+  const NestedFit* base_cheap = search.cheap({});
+  if (!base_cheap) throw AnalysisError("explain: the linear model cannot be fitted");
+
+  // 1. Cheap scores of every subset; c from the whole library's cheap fit (least misfit).
+  const std::vector<Terms> all = subsetsUpTo(search.names(), options.max_steps);
+  const NestedFit* widest = search.cheap(search.names());
+  for (const auto& t : all) search.cheap(t);
+  if (!widest) {
+    for (const auto& t : all) {
+      const NestedFit* f = search.cheap(t);
+      if (f && (!widest || t.size() > widest->extensions.size() ||
+                (t.size() == widest->extensions.size() && f->rss < widest->rss)))
+        widest = f;
+    }
+  }
+  result.correlation_factor_ls = longRunVarianceFactor(widest->residuals, 4);
+  const double c_ls = result.correlation_factor_ls;
+  std::vector<SubsetScore> scores;
+  for (const auto& t : all) {
+    const NestedFit* f = search.cheap(t);
+    if (!f) continue;
+    SubsetScore s;
+    s.terms = t;
+    s.model = modelSpecOf(t);
+    s.criterion_ls = search.criterion(*f, t.size(), c_ls);
+    s.criterion = s.criterion_ls;
+    s.sigma = f->sigma;
+    scores.push_back(s);
+  }
+  std::stable_sort(scores.begin(), scores.end(), [](const SubsetScore& a, const SubsetScore& b) {
+    return a.criterion_ls < b.criterion_ls;
+  });
+
+  // 2. Refine the linear model and the finalists.
+  std::vector<Terms> finalists = {{}};
+  for (const auto& s : scores)
+    if (!s.terms.empty() && static_cast<int>(finalists.size()) <= options.finalists)
+      finalists.push_back(s.terms);
+  const NestedFit* base = search.refined({});
+  const bool refined_scale = fitter.refinesByOutputError() && base != nullptr;
+  if (fitter.refinesByOutputError() && !base && notes)
+    notes->push_back("the linear model's output-error fit failed: subsets compared on LS alone");
+  double c = c_ls;
+  auto fitOf = [&](const Terms& t) { return refined_scale ? search.refined(t) : search.cheap(t); };
+  if (refined_scale) {
+    const NestedFit* largest = nullptr;
+    for (const auto& t : finalists) {
+      const NestedFit* f = fitOf(t);
+      if (f && (!largest || t.size() > largest->extensions.size())) largest = f;
+    }
+    c = std::max(longRunVarianceFactor(adequacyVector(fitter, *largest), 4),
+                 longRunVarianceFactor(fitter.knownNoiseCorrelation()));
+  }
+  result.correlation_factor = c;
+  std::map<std::string, double> crit;
+  auto score = [&](const Terms& t) {
+    const std::string k = key(t);
+    const auto it = crit.find(k);
+    if (it != crit.end()) return it->second;
+    const NestedFit* f = fitOf(t);
+    const double v = f ? search.criterion(*f, t.size(), c) : kInf;
+    crit[k] = v;
+    return v;
+  };
+  for (const auto& t : finalists) score(t);
+
+  // 3. Best refined subset, backward check, hold-out confirmation.
+  auto ranked = [&]() {
+    std::vector<std::pair<double, Terms>> r;
+    for (const auto& kv : crit) {
+      for (const auto& s : all)
+        if (key(s) == kv.first && std::isfinite(kv.second)) r.push_back({kv.second, s});
+    }
+    std::stable_sort(r.begin(), r.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    return r;
+  };
+  const double base_crit = score({});
+  std::vector<std::string> rejected_keys;
+  Terms chosen;
+  auto rejected = [&](const Terms& t) {
+    return std::find(rejected_keys.begin(), rejected_keys.end(), key(t)) != rejected_keys.end();
+  };
+  auto drop = [&](const std::string& n) {
+    if (std::find(result.dropped.begin(), result.dropped.end(), n) == result.dropped.end())
+      result.dropped.push_back(n);
+  };
+  for (;;) {
+    Terms top;
+    bool found = false;
+    for (const auto& r : ranked()) {
+      if (rejected(r.second)) continue;
+      top = r.second;
+      found = true;
+      break;
+    }
+    if (!found || top.empty() || !(score(top) < base_crit)) break;
+    rejected_keys.push_back(key(top));  // each round retires its pick: the loop ends
+    // Backward check: a term goes when the subset without it scores better.
+    Terms best = top;
+    bool shrunk = options.backward_check;
+    while (shrunk && !best.empty()) {
+      shrunk = false;
+      Terms better = best;
+      for (const auto& name : best) {
+        const Terms smaller = without(best, name);
+        if (score(smaller) < score(better)) better = smaller;
+      }
+      if (better != best) {
+        for (const auto& n : best)
+          if (std::find(better.begin(), better.end(), n) == better.end()) drop(n);
+        if (notes)
+          notes->push_back("backward check: " + key(best) + " -> " + key(better) + " (criterion " +
+                           num(score(best)) + " -> " + num(score(better)) + ")");
+        best = better;
+        shrunk = true;
+      }
+    }
+    if (best.empty()) break;
+    if (best != top && rejected(best)) continue;
+    if (best != top) rejected_keys.push_back(key(best));
+    const double h = ratio(search.holdout({}), search.holdout(best));
+    if (h > options.min_holdout_ratio) {
+      chosen = best;
+      break;
+    }
+    for (const auto& n : best) drop(n);
+    if (notes)
+      notes->push_back("hold-out confirmation: " + key(best) +
+                       " (best criterion) predicts the held-out data no better than the linear "
+                       "model (ratio " +
+                       num(h) + "): not chosen");
+  }
+
+  result.dropped.erase(std::remove_if(result.dropped.begin(), result.dropped.end(),
+                                      [&](const std::string& n) {
+                                        return std::find(chosen.begin(), chosen.end(), n) !=
+                                               chosen.end();
+                                      }),
+                       result.dropped.end());
+
+  // 4. Steps ladder, runner-up, subset table.
+  const NestedFit* prev = fitOf({});
+  if (!prev) prev = base_cheap;
+  result.baseline = *prev;
+  Terms prefix;
+  while (prefix.size() < chosen.size()) {
+    std::string add;
+    double best_v = kInf;
+    for (const auto& n : chosen) {
+      if (std::find(prefix.begin(), prefix.end(), n) != prefix.end()) continue;
+      Terms t = prefix;
+      t.push_back(n);
+      const double v = score(search.canonical(t));
+      if (add.empty() || v < best_v) add = n, best_v = v;
+    }
+    Terms next = prefix;
+    next.push_back(add);
+    const NestedFit* f = fitOf(search.canonical(next));
+    if (!f) break;
+    SelectionStep s;
+    s.added = add;
+    s.fit = *f;
+    s.model = f->model;
+    s.sigma = f->sigma;
+    s.sigma_ratio = ratio(prev->sigma, f->sigma);
+    s.wald = waldTest(f->estimate, {add});
+    s.delta_bic =
+        deltaBic(prev->rss, f->rss, f->n_equations, f->estimate.n_params - prev->estimate.n_params);
+    s.holdout_ratio =
+        ratio(search.holdout(search.canonical(prefix)), search.holdout(search.canonical(next)));
+    s.delta_criterion = best_v - score(search.canonical(prefix));
+    s.threshold = options.alpha;
+    s.accepted = true;
+    result.steps.push_back(s);
+    prefix = next;
+    prev = f;
+  }
+  result.selected = prefix;
+  result.final_fit = *prev;
+  result.final_fit.extensions = prefix;
+  const Terms chosen_c = search.canonical(prefix);
+  // Candidates one term beyond the chosen subset that were refined (the verdict's near misses).
+  for (const auto& name : search.names()) {
+    if (std::find(chosen_c.begin(), chosen_c.end(), name) != chosen_c.end()) continue;
+    Terms t = chosen_c;
+    t.push_back(name);
+    t = search.canonical(t);
+    if (!crit.count(key(t)) || !std::isfinite(crit[key(t)])) continue;
+    const NestedFit* f = fitOf(t);
+    SelectionStep s;
+    s.added = name;
+    s.fit = *f;
+    s.model = f->model;
+    s.sigma = f->sigma;
+    s.sigma_ratio = ratio(prev->sigma, f->sigma);
+    s.wald = waldTest(f->estimate, {name});
+    s.delta_bic =
+        deltaBic(prev->rss, f->rss, f->n_equations, f->estimate.n_params - prev->estimate.n_params);
+    s.delta_criterion = crit[key(t)] - score(chosen_c);
+    s.threshold = options.alpha;
+    result.last_round.push_back(s);
+  }
+  for (auto& s : scores) {
+    const std::string k = key(s.terms);
+    if (crit.count(k)) {
+      s.refined = true;
+      s.criterion = crit[k];
+      if (const NestedFit* f = fitOf(s.terms)) s.sigma = f->sigma;
+    }
+    // Hold-out ratios only where they were computed (no extra fits for the table).
+    if (search.hasHoldout(s.terms))
+      s.holdout_ratio = ratio(search.holdout({}), search.holdout(s.terms));
+  }
+  result.subsets = scores;
+  auto scoreOf = [&](const Terms& t) {
+    for (const auto& s : scores)
+      if (key(s.terms) == key(t)) return s;
+    SubsetScore s;
+    s.terms = t;
+    s.model = modelSpecOf(t);
+    return s;
+  };
+  result.chosen = scoreOf(chosen_c);
+  double runner = kInf;
+  for (const auto& r : ranked()) {
+    if (key(r.second) == key(chosen_c)) continue;
+    result.runner_up = scoreOf(r.second);
+    runner = r.first;
+    break;
+  }
+  result.runner_up_delta = std::isfinite(runner) ? runner - score(chosen_c) : kInf;
+  std::ostringstream d;
+  d << "best subset of up to " << options.max_steps << " of " << search.names().size()
+    << " candidates by IC = n_eff ln(RSS/N) + k max(ln n_eff, " << num(search.penaltyFloor())
+    << "), n_eff = N / c; ranked on the equation-error LS fit (c = " << num(c_ls) << "), the "
+    << "linear model and " << options.finalists << " finalists refined"
+    << (refined_scale ? " by the output-error fit (c = " + num(c) + ")" : "")
+    << ", confirmed on the hold-out";
+  result.criterion_description = d.str();
+  return result;
+}
+
+}  // namespace cvg_bench

@@ -1,0 +1,128 @@
+#include "cvg_bench/core/io/input_checks.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "cvg_bench/core/model/errors.h"
+
+namespace cvg_bench {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string fmt(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof(buf), "%.6g", v);
+  return buf;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + mid, v.end());
+  return v[mid];
+}
+
+}  // namespace
+
+void requireOmegaInRange(double omega_rad_s, const std::string& what) {
+  if (!std::isfinite(omega_rad_s) || !(omega_rad_s > 0.0) || omega_rad_s > kMaxOmegaRadS)
+    throw InputError(what + ": omega " + fmt(omega_rad_s) + " rad/s is out of range (must be > 0 " +
+                     "and <= " + fmt(kMaxOmegaRadS) + " rad/s)");
+}
+
+void requireInputFile(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (path.empty()) throw InputError(what + ": empty file name");
+  if (ec || !fs::exists(st)) throw InputError(path + ": " + what + " does not exist");
+  if (fs::is_directory(st)) throw InputError(path + ": " + what + " is a directory, not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": " + what + " cannot be opened for reading");
+}
+
+void requireOutputFile(const std::string& path, const std::string& what) {
+  if (path.empty()) throw InputError(what + ": empty file name");
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw InputError(path + ": " + what + " is a directory; give a file name");
+  fs::path parent = fs::path(path).parent_path();
+  if (parent.empty()) parent = ".";
+  if (!fs::is_directory(parent, ec))
+    throw InputError(path + ": " + what + ": directory " + parent.string() + " does not exist");
+  if (fs::exists(path, ec) ? ::access(path.c_str(), W_OK) != 0
+                           : ::access(parent.c_str(), W_OK) != 0)
+    throw InputError(path + ": " + what + " is not writable");
+}
+
+void checkStateColumns(const std::vector<std::pair<std::string, const std::vector<double>*>>& cols,
+                       const RowLocator& where) {
+  if (cols.empty()) return;
+  const size_t n = cols.front().second->size();
+  std::vector<double> row_max(n, 0.0);
+  for (const auto& c : cols) {
+    const std::vector<double>& v = *c.second;
+    for (size_t r = 0; r < n; ++r) {
+      if (!std::isfinite(v[r]))
+        throw InputError(where(r, c.first) + "column '" + c.first + "': " + fmt(v[r]) +
+                         " is not finite");
+      if (std::fabs(v[r]) > kMaxStateMagnitude)
+        throw InputError(where(r, c.first) + "column '" + c.first + "': " + fmt(v[r]) +
+                         " [record units] is out of range (|value| > " + fmt(kMaxStateMagnitude) +
+                         ")");
+      row_max[r] = std::max(row_max[r], std::fabs(v[r]));
+    }
+  }
+  const double typical = median(row_max);
+  if (!(typical > 0.0)) return;  // all-zero records are judged by the data-sufficiency checks
+  const double limit = kMaxStateOverTypical * typical;
+  for (const auto& c : cols) {
+    const std::vector<double>& v = *c.second;
+    for (size_t r = 0; r < n; ++r) {
+      if (std::fabs(v[r]) > limit)
+        throw InputError(where(r, c.first) + "column '" + c.first + "': " + fmt(v[r]) +
+                         " [record units] is " + fmt(std::fabs(v[r]) / typical) +
+                         " times the record's typical magnitude " + fmt(typical) + " (limit " +
+                         fmt(kMaxStateOverTypical) + "x): a corrupted sample");
+    }
+  }
+}
+
+void checkTimeColumn(const std::vector<double>& t_s, const std::string& name,
+                     const RowLocator& where) {
+  for (size_t r = 0; r < t_s.size(); ++r) {
+    if (!std::isfinite(t_s[r]) || std::fabs(t_s[r]) > kMaxTimeS)
+      throw InputError(where(r, name) + "time " + fmt(t_s[r]) +
+                       " s is out of range (|t| <= " + fmt(kMaxTimeS) + " s)");
+  }
+  if (t_s.size() < 3) return;
+  std::vector<double> dt(t_s.size() - 1);
+  for (size_t r = 1; r < t_s.size(); ++r) dt[r - 1] = t_s[r] - t_s[r - 1];
+  const double typical = median(dt);
+  if (!(typical > 0.0)) return;
+  for (size_t r = 1; r < t_s.size(); ++r) {
+    if (dt[r - 1] > kMaxIntervalOverMedian * typical)
+      throw InputError(where(r, name) + "time jumps by " + fmt(dt[r - 1]) +
+                       " s from the previous " + "sample, " + fmt(dt[r - 1] / typical) +
+                       " times the median interval " + fmt(typical) + " s (limit " +
+                       fmt(kMaxIntervalOverMedian) + "x): a clock jump");
+  }
+}
+
+void checkExcitationColumn(const std::vector<double>& omega0_rad_s, const std::string& name,
+                           const RowLocator& where) {
+  for (size_t r = 0; r < omega0_rad_s.size(); ++r) {
+    const double w = omega0_rad_s[r];
+    if (!std::isfinite(w) || !(w > 0.0) || w > kMaxOmegaRadS)
+      throw InputError(where(r, name) + "column '" + name + "': " + fmt(w) +
+                       " rad/s is out of range (must be > 0 and <= " + fmt(kMaxOmegaRadS) +
+                       " rad/s)");
+  }
+}
+
+}  // namespace cvg_bench
