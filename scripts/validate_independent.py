@@ -578,6 +578,7 @@ def load_runs(args):
         elapsed += d["elapsed_s"]
         kinds += [k for k in d["kinds"] if k not in kinds]
         terms = d.get("library_terms_beyond_ten", []) if terms is None else terms
+        args.tool_commit = d.get("tool", "?")
         gen += d.get("gen_cpu_s", 0.0)
     args.terms, args.gen_cpu = terms or [], gen
     args.kinds = ",".join(k for k in KINDS if k in kinds)
@@ -782,7 +783,8 @@ def report_header(args, elapsed, n):
                 time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), " --quick" if args.quick else "",
                 " --coverage-runs %d" % args.coverage_runs if args.coverage_runs != 60 else "",
                 "" if args.kinds == ",".join(KINDS) else " --kinds " + args.kinds, n, elapsed,
-                args.jobs, tool_version(args.tool), ", ".join(args.terms) or "none"),
+                args.jobs, getattr(args, "tool_commit", None) or tool_version(args.tool),
+                ", ".join(args.terms) or "none"),
             "", "Cost: the tool's CPU time (user + system, summed over runs) %.0f s, i.e. %.1f min "
             "on %d unloaded cores; generator %.0f s (CPU, cached trajectories not counted). "
             "Wall time depends on the machine's load." % (
