@@ -539,6 +539,8 @@ def main():
     ap.add_argument("--quick", action="store_true", help="smoke subset (~5 explain runs)")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--coverage-runs", type=int, default=60)
+    ap.add_argument("--thin", type=int, default=1,
+                    help="explain: keep clean records and 1/THIN of the others (seed-chosen)")
     ap.add_argument("--json", default="", help="all results as JSON")
     ap.add_argument("--markdown", default="", help="write the full report (tables) here")
     ap.add_argument("--work", default="", help="cache the clean trajectories in this folder")
@@ -578,6 +580,7 @@ def load_runs(args):
         elapsed += d["elapsed_s"]
         kinds += [k for k in d["kinds"] if k not in kinds]
         terms = d.get("library_terms_beyond_ten", []) if terms is None else terms
+        args.tool_commit = d.get("tool", "?")
         gen += d.get("gen_cpu_s", 0.0)
     args.terms, args.gen_cpu = terms or [], gen
     args.kinds = ",".join(k for k in KINDS if k in kinds)
@@ -606,6 +609,9 @@ def run_all(args, kinds):
     for c in cases:  # a case keeps its seed when other cases are added (before/after comparisons)
         c["seed"] = SEED0 + stable(json.dumps([c["kind"], c["preset"], c["label"], c["noise"],
                                                c["rep"]])) % 1000000
+    if args.thin > 1:  # keep the clean records, and a seed-chosen 1/thin of the others
+        cases = [c for c in cases if c["kind"].startswith("cov_") or c["label"] == "none"
+                 or c["seed"] % args.thin == 0]
     if args.quick:  # the smoke subset: explain cases, plus at most 1 coverage pair
         cov = [c for c in cases if c["kind"].startswith("cov_")][:2]
         cases = [c for c in cases if not c["kind"].startswith("cov_")] + cov
@@ -780,9 +786,11 @@ def report_header(args, elapsed, n):
             "(%d runs, %.0f s on %d worker processes; tool %s, library terms beyond the original ten "
             "that it names: %s)." % (
                 time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), " --quick" if args.quick else "",
-                " --coverage-runs %d" % args.coverage_runs if args.coverage_runs != 60 else "",
+                (" --coverage-runs %d" % args.coverage_runs if args.coverage_runs != 60 else "")
+                + (" --thin %d (fd_slow)" % args.thin if args.thin > 1 else ""),
                 "" if args.kinds == ",".join(KINDS) else " --kinds " + args.kinds, n, elapsed,
-                args.jobs, tool_version(args.tool), ", ".join(args.terms) or "none"),
+                args.jobs, getattr(args, "tool_commit", None) or tool_version(args.tool),
+                ", ".join(args.terms) or "none"),
             "", "Cost: the tool's CPU time (user + system, summed over runs) %.0f s, i.e. %.1f min "
             "on %d unloaded cores; generator %.0f s (CPU, cached trajectories not counted). "
             "Wall time depends on the machine's load." % (

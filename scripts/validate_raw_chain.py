@@ -30,14 +30,6 @@ SEED0 = 60000  # disjoint from the unit tests (< 10000) and the independent harn
 LAG2 = re.compile(r"lag-2-block correlation (-?[0-9.eE+-]+)")
 
 
-def wilson(k, n, z=1.959964):
-    """Wilson score interval of a binomial proportion k / n."""
-    p = k / n
-    c = (p + z * z / (2 * n)) / (1 + z * z / n)
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return c - h, c + h
-
-
 def truth_of(path):
     truth = {}
     with open(path) as f:
