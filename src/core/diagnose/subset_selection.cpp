@@ -99,10 +99,7 @@ class SubsetSearch {
   const NestedFit* cheap(const Terms& t) { return cached(t, &cheap_, false); }
   const NestedFit* refined(const Terms& t) {
     if (!fitter_.refinesByOutputError()) return cheap(t);
-    const NestedFit* f = cached(t, &refined_, true);
-    // A free-decay refinement that fell back to LS has residuals in other units: not comparable.
-    if (f && f->estimate.method != "ceres") return nullptr;
-    return f;
+    return cached(t, &refined_, true);
   }
 
   double criterion(const NestedFit& f, size_t k, double c) const {
@@ -227,11 +224,12 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     if (!s.terms.empty() && static_cast<int>(finalists.size()) <= options.finalists)
       finalists.push_back(s.terms);
   const NestedFit* base = search.refined({});
-  const bool refined_scale = fitter.refinesByOutputError() && base != nullptr;
+  const bool refined_scale =
+      fitter.refinesByOutputError() && base != nullptr && base->estimate.method == "ceres";
   if (fitter.refinesByOutputError() && !base && notes)
     notes->push_back("the linear model's output-error fit failed: subsets compared on LS alone");
   double c = c_ls;
-  auto fitOf = [&](const Terms& t) { return refined_scale ? search.refined(t) : search.cheap(t); };
+  auto fitOf = [&](const Terms& t) { return search.refined(t); };
   if (refined_scale) {
     const NestedFit* largest = nullptr;
     for (const auto& t : finalists) {
@@ -248,7 +246,9 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     const auto it = crit.find(k);
     if (it != crit.end()) return it->second;
     const NestedFit* f = fitOf(t);
-    const double v = f ? search.criterion(*f, t.size(), c) : kInf;
+    // A free-decay refinement that fell back to LS has residuals in other units: not comparable.
+    const bool comparable = f && (!refined_scale || f->estimate.method == "ceres");
+    const double v = comparable ? search.criterion(*f, t.size(), c) : kInf;
     crit[k] = v;
     return v;
   };
