@@ -252,7 +252,18 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     crit[k] = v;
     return v;
   };
-  for (const auto& t : finalists) score(t);
+  // A finalist whose output-error fit failed is not comparable: refine further subsets in LS order
+  // until `finalists` comparable ones exist (at most twice as many tried).
+  int comparable = 0;
+  for (const auto& t : finalists)
+    if (!t.empty() && std::isfinite(score(t))) ++comparable;
+  int tried = static_cast<int>(finalists.size()) - 1;
+  for (const auto& sc : scores) {
+    if (comparable >= options.finalists || tried >= 2 * options.finalists) break;
+    if (sc.terms.empty() || crit.count(key(sc.terms))) continue;
+    ++tried;
+    if (std::isfinite(score(sc.terms))) ++comparable;
+  }
 
   // 3. Best refined subset, backward check, hold-out confirmation.
   auto ranked = [&]() {
