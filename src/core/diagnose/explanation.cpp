@@ -181,7 +181,11 @@ Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
   // (residual_noise_model.h); the runs test and the final signature see whitened residuals.
   const std::vector<BlockResidual> adequacy = fitter.adequacyResiduals(x.selection.final_fit);
   const std::vector<double> known = fitter.knownNoiseCorrelation();
-  if (!known.empty()) {
+  if (mode == ExperimentMode::kForced) {
+    // Stationary sweep points share no samples: independent under an adequate model, and a
+    // missing effect varies from point to point near resonance (an AR(1) fit would absorb it).
+    x.noise_model.description = "white (sweep points are independent measurements)";
+  } else if (!known.empty()) {
     x.noise_model = noiseModelFromCorrelation(known);
   } else {
     Eigen::VectorXd e(4 * adequacy.size());

@@ -38,6 +38,30 @@ NestedFit fitSystem(const StackedSystem& sys, const IdentificationOptions& o,
   return f;
 }
 
+/// LS residuals only (column-equilibrated pivoted QR, no covariance): the cheap fit that ranks
+/// subsets by their residual sums.
+NestedFit residualsOnly(const StackedSystem& sys, const std::vector<std::string>& extensions) {
+  NestedFit f;
+  f.extensions = extensions;
+  f.model = sys.model;
+  const Eigen::VectorXd norms = sys.d.colwise().norm().transpose().cwiseMax(1e-300);
+  const Eigen::MatrixXd scaled = sys.d * norms.cwiseInverse().asDiagonal();
+  const Eigen::VectorXd z =
+      scaled.colPivHouseholderQr().solve(sys.y).cwiseQuotient(norms);
+  f.residuals = sys.y - sys.d * z;
+  f.rss = f.residuals.squaredNorm();
+  f.n_equations = static_cast<long>(sys.y.size());
+  const long dof = std::max<long>(1, f.n_equations - sys.d.cols());
+  f.sigma = std::sqrt(f.rss / static_cast<double>(dof));
+  f.estimate.model = sys.model;
+  f.estimate.method = "ls";
+  f.estimate.names = sys.names;
+  f.estimate.values = z;
+  f.estimate.n_params = static_cast<int>(sys.d.cols());
+  f.estimate.sigma = f.sigma;
+  return f;
+}
+
 /// Forced LS (per-point cluster sandwich intervals) plus the equation residuals.
 NestedFit fitRecord(const SweepRecord& record, const IdentificationOptions& o,
                     const std::vector<std::string>& extensions) {
@@ -67,7 +91,7 @@ class FreeDecayFitter : public NestedModelFitter {
   NestedFit fitEquationError(const std::vector<std::string>& extensions) const override {
     IdentificationOptions o = options_.identification;
     o.model = ResonatorModel(extensions, ExperimentMode::kFreeDecay).spec();
-    return fitSystem(buildFreeDecaySystem({record_}, o), o, extensions);
+    return residualsOnly(buildFreeDecaySystem({record_}, o), extensions);
   }
   bool refinesByOutputError() const override { return true; }
   std::vector<double> knownNoiseCorrelation() const override {

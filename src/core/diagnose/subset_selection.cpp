@@ -102,10 +102,7 @@ class SubsetSearch {
   const NestedFit* cheap(const Terms& t) { return cached(t, &cheap_, false); }
   const NestedFit* refined(const Terms& t) {
     if (!fitter_.refinesByOutputError()) return cheap(t);
-    const NestedFit* f = cached(t, &refined_, true);
-    // A free-decay refinement that fell back to LS has residuals in other units: not comparable.
-    if (f && f->estimate.method != "ceres") return nullptr;
-    return f;
+    return cached(t, &refined_, true);
   }
 
   double criterion(const NestedFit& f, size_t k, double c) const {
@@ -230,11 +227,12 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     if (!s.terms.empty() && static_cast<int>(finalists.size()) <= options.finalists)
       finalists.push_back(s.terms);
   const NestedFit* base = search.refined({});
-  const bool refined_scale = fitter.refinesByOutputError() && base != nullptr;
+  const bool refined_scale =
+      fitter.refinesByOutputError() && base != nullptr && base->estimate.method == "ceres";
   if (fitter.refinesByOutputError() && !base && notes)
     notes->push_back("the linear model's output-error fit failed: subsets compared on LS alone");
   double c = c_ls;
-  auto fitOf = [&](const Terms& t) { return refined_scale ? search.refined(t) : search.cheap(t); };
+  auto fitOf = [&](const Terms& t) { return search.refined(t); };
   if (refined_scale) {
     const NestedFit* largest = nullptr;
     for (const auto& t : finalists) {
@@ -251,11 +249,24 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     const auto it = crit.find(k);
     if (it != crit.end()) return it->second;
     const NestedFit* f = fitOf(t);
-    const double v = f ? search.criterion(*f, t.size(), c) : kInf;
+    // A free-decay refinement that fell back to LS has residuals in other units: not comparable.
+    const bool comparable = f && (!refined_scale || f->estimate.method == "ceres");
+    const double v = comparable ? search.criterion(*f, t.size(), c) : kInf;
     crit[k] = v;
     return v;
   };
-  for (const auto& t : finalists) score(t);
+  // A finalist whose output-error fit failed is not comparable: refine further subsets in LS order
+  // until `finalists` comparable ones exist (at most twice as many tried).
+  int comparable = 0;
+  for (const auto& t : finalists)
+    if (!t.empty() && std::isfinite(score(t))) ++comparable;
+  int tried = static_cast<int>(finalists.size()) - 1;
+  for (const auto& sc : scores) {
+    if (comparable >= options.finalists || tried >= 2 * options.finalists) break;
+    if (sc.terms.empty() || crit.count(key(sc.terms))) continue;
+    ++tried;
+    if (std::isfinite(score(sc.terms))) ++comparable;
+  }
 
   // 3. Best refined subset, backward check, hold-out confirmation.
   auto ranked = [&]() {
