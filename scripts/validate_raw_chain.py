@@ -27,7 +27,7 @@ import tempfile
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TOOL = os.path.join(REPO, "bin", "cvg_ident")
 SEED0 = 60000  # disjoint from the unit tests (< 10000) and the independent harness (50000 + index)
-LAG2 = re.compile(r"lag-2-block correlation (-?[0-9.eE+-]+)")
+LAG2 = re.compile(r"lag-2 (-?[0-9.eE+-]+) \(white")
 
 
 def truth_of(path):
