@@ -167,6 +167,7 @@ void IdentifierNode::trackExperiment(const ros::Time& epoch, const ros::Time& st
 }
 
 void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
+  countSequence(msg->header.seq);
   Eigen::Vector4d q;
   try {
     q = slowFromMsg(*msg);
@@ -178,7 +179,6 @@ void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
     return;
   }
   const ros::Time stamp = msg->header.stamp;
-  countSequence(msg->header.seq);
   trackExperiment(msg->phase_epoch, stamp);
   if (have_latest_ && stamp == latest_stamp_) {
     ++dropped_;

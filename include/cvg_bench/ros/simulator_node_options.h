@@ -43,7 +43,7 @@ struct SimulatorNodeOptions {
   double max_duration_s = 600.0;
   /// Most raw samples in one RawSampleBatch, >= 1000: when the node falls behind real time it
   /// publishes at most this many per tick and reports the lag instead of sending huge messages.
-  int max_batch_samples = 100000;
+  int max_batch_samples = 50000;
   /// frame_id of the published headers.
   std::string frame_id = "resonator";
 
