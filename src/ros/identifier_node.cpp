@@ -405,7 +405,6 @@ void IdentifierNode::publishFrames() {
 }
 
 void IdentifierNode::publishMarkers() {
-  if (markers_pub_.getNumSubscribers() == 0) return;
   BenchView v;
   v.frame_id = options_.frame_id;
   v.stamp = latest_stamp_;

@@ -12,6 +12,7 @@ import rosgraph
 import rospy
 import rostest
 import tf2_ros
+import yaml
 
 from cvg_bench.msg import ModelEstimate, SimulationTruth
 
@@ -63,8 +64,12 @@ class TwoGyros(unittest.TestCase):
                                                  rospy.Time(0))
                     time.sleep(0.05)  # poll period of the bounded wait
                 self.assertTrue(ok, "%s/%s" % (g, child))
-        frames = tf_buffer.all_frames_as_yaml()
-        self.assertNotIn("\nresonator:", "\n" + frames)  # no un-prefixed frame
+        frames = yaml.safe_load(tf_buffer.all_frames_as_yaml()) or {}
+        self.assertEqual(len(frames), 6, frames)  # 3 child frames per gyro, none shared
+        for child, info in frames.items():
+            gyro = child.split("/")[0]
+            self.assertIn(gyro, GYROS, child)
+            self.assertEqual(info["parent"], "%s/resonator" % gyro)
         publishers, _, services = rosgraph.Master("/two_gyros_check").getSystemState()
         for topic, nodes in publishers:
             if topic in SHARED:

@@ -28,7 +28,7 @@ struct DemodulatorNodeOptions {
   int queue_size = 1000;
   /// Queue length of the raw subscription [batches], >= 1: a short queue bounds the memory when
   /// the input outruns the node (the oldest batches are dropped and counted).
-  int raw_queue_size = 20;
+  int raw_queue_size = 100;
 
   std::vector<std::string> validate() const;
   void load(ParamReader& reader);
