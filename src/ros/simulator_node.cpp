@@ -65,8 +65,11 @@ void SimulatorNode::onAutostartTimer(const ros::WallTimerEvent&) {
   if (first.getNumSubscribers() == 0) {
     const uint32_t others = forced ? raw_pub_.getNumSubscribers() + slow_pub_.getNumSubscribers()
                                    : sweep_pub_.getNumSubscribers();
-    if (!autostart_warned_ && others > 0 && (ros::WallTime::now() - autostart_since_).toSec() > 3.0) {
-      autostart_warned_ = true;
+    // Warned after 3 s of waiting, then every 5 s while the mismatch lasts.
+    const ros::WallTime now = ros::WallTime::now();
+    if (others > 0 && (now - autostart_since_).toSec() > 3.0 &&
+        (last_autostart_warning_.isZero() || (now - last_autostart_warning_).toSec() > 5.0)) {
+      last_autostart_warning_ = now;
       ROS_WARN("autostart:=%s waits for a subscriber of %s, but only the %s experiment's topics "
                "have subscribers: is the identifier's mode %s? (start both with the same mode)",
                options_.autostart.c_str(), first.getTopic().c_str(),

@@ -16,16 +16,19 @@ BAD = {"mode": "sideways", "confidence": "2.0", "window_s": "-1.0", "queue_size"
 EXPECTED = ["mode:", "confidence", "window_s: must be >= 0", "queue_size: must be >= 1"]
 
 
+LOCK = threading.Lock()
+LOGS = []  # every /rosout message since the test node started (shared by the tests)
+
+
+def on_log(msg):
+    with LOCK:
+        LOGS.append(msg)
+
+
 class StartupFailure(unittest.TestCase):
     def setUp(self):
-        self.lock = threading.Lock()
-        self.logs = []
-        rospy.Subscriber("/rosout_agg", Log, self.on_log)
-        time.sleep(0.5)  # the subscription connects to rosout before anything is started
-
-    def on_log(self, msg):
-        with self.lock:
-            self.logs.append(msg)
+        self.lock = LOCK
+        self.logs = LOGS
 
     def test_invalid_settings_are_listed_everywhere(self):
         args = ["rosrun", "cvg_bench", "identifier_node", "__name:=bad_identifier"]
@@ -61,4 +64,8 @@ class StartupFailure(unittest.TestCase):
 
 if __name__ == "__main__":
     rospy.init_node("startup_failure_test")
+    # /rosout directly: rostest starts no rosout node (no /rosout_agg); a failing node waits for a
+    # /rosout subscriber before it logs.
+    rospy.Subscriber("/rosout", Log, on_log)
+    time.sleep(0.5)  # the subscription is registered before the tests start anything
     rostest.rosrun("cvg_bench", "startup_failure", StartupFailure)

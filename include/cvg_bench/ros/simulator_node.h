@@ -47,7 +47,7 @@ class SimulatorNode {
   void publishDueSweep(double wall_elapsed_s);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   /// Autostart: starts once the experiment's first consumer is connected; warns once when only
-  /// consumers of the other experiment's topic are (mode / autostart mismatch).
+  /// consumers of the other experiment's topic are (mode / autostart mismatch), every 5 s.
   void onAutostartTimer(const ros::WallTimerEvent&);
 
   ros::NodeHandle nh_;
@@ -63,7 +63,7 @@ class SimulatorNode {
   diagnostic_updater::Updater diagnostics_;
   ros::WallTimer diagnostics_timer_;
   ros::WallTime autostart_since_;
-  bool autostart_warned_ = false;
+  ros::WallTime last_autostart_warning_;
   uint64_t raw_published_ = 0, raw_at_last_diag_ = 0, raw_batches_ = 0, capped_ticks_ = 0;
   uint64_t slow_published_ = 0, sweep_published_ = 0, experiments_ = 0;
   double lag_s_ = 0.0, max_lag_s_ = 0.0;
