@@ -45,9 +45,10 @@ visualization_msgs::Marker arrow(const BenchView& v, int id, double angle, doubl
   return m;
 }
 
-visualization_msgs::Marker label(const BenchView& v, int id, double angle, double radius,
-                                 double z, const std::string& text) {
-  visualization_msgs::Marker m = base(v, "labels", id, visualization_msgs::Marker::TEXT_VIEW_FACING);
+visualization_msgs::Marker label(const BenchView& v, int id, double angle, double radius, double z,
+                                 const std::string& text) {
+  visualization_msgs::Marker m =
+      base(v, "labels", id, visualization_msgs::Marker::TEXT_VIEW_FACING);
   m.pose.position = point(radius * std::cos(angle), radius * std::sin(angle), z);
   m.scale.z = 0.14;  // text height
   m.text = text;

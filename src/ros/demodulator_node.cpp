@@ -167,7 +167,8 @@ void DemodulatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   for (const auto& kv : counts) stat.add(kv.first, kv.second);
   const ros::WallTime now = ros::WallTime::now();
   const double dt = last_diag_wall_.isZero() ? 0.0 : (now - last_diag_wall_).toSec();
-  stat.add("input_rate_samples_per_s", dt > 0.0 ? (samples_in_ - samples_in_at_last_diag_) / dt : 0.0);
+  stat.add("input_rate_samples_per_s",
+           dt > 0.0 ? (samples_in_ - samples_in_at_last_diag_) / dt : 0.0);
   last_diag_wall_ = now;
   samples_in_at_last_diag_ = samples_in_;
   stat.add("raw_samples_received", samples_in_);

@@ -26,7 +26,8 @@ std::vector<std::string> sanityProblems(const Estimate& e) {
   std::vector<std::string> p;
   for (Eigen::Index i = 0; i < e.values.size(); ++i)
     if (!std::isfinite(e.values[i]))
-      p.push_back("parameter " + (i < static_cast<Eigen::Index>(e.names.size()) ? e.names[i] : "?") +
+      p.push_back("parameter " +
+                  (i < static_cast<Eigen::Index>(e.names.size()) ? e.names[i] : "?") +
                   " is not finite");
   if (const ParameterEstimate* g = find(e.parameters, "gamma")) {
     if (!(g->value > 0.0))

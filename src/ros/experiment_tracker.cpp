@@ -34,11 +34,16 @@ void ExperimentTracker::onStartEvent(const ros::Time& start) {
 
 std::string ExperimentTracker::describe(Boundary b) {
   switch (b) {
-    case Boundary::kNone: return "same experiment";
-    case Boundary::kFirst: return "first data";
-    case Boundary::kNewEpoch: return "new phase epoch (the experiment was restarted)";
-    case Boundary::kJumpBack: return "data jumped back in time (looped bag or restarted replay)";
-    case Boundary::kStartEvent: return "start event from the simulator";
+    case Boundary::kNone:
+      return "same experiment";
+    case Boundary::kFirst:
+      return "first data";
+    case Boundary::kNewEpoch:
+      return "new phase epoch (the experiment was restarted)";
+    case Boundary::kJumpBack:
+      return "data jumped back in time (looped bag or restarted replay)";
+    case Boundary::kStartEvent:
+      return "start event from the simulator";
   }
   return "?";
 }

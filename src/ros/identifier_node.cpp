@@ -11,9 +11,9 @@
 #include "cvg_bench/DerivedQuantitiesStamped.h"
 #include "cvg_bench/DriftRate.h"
 #include "cvg_bench/ModelEstimate.h"
+#include "cvg_bench/core/diagnose/explanation.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
 #include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/diagnose/explanation.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/report/explain_json.h"
 #include "cvg_bench/ros/bench_markers.h"
@@ -83,6 +83,9 @@ IdentifierNode::IdentifierNode(const ros::NodeHandle& nh, const ros::NodeHandle&
   reset_srv_ = nh_.advertiseService("identifier/reset", &IdentifierNode::onReset, this);
   explain_srv_ = nh_.advertiseService("explain", &IdentifierNode::onExplain, this);
   timer_ = nh_.createWallTimer(ros::WallDuration(0.05), &IdentifierNode::onTimer, this);
+  reconfigure_.reset(new dynamic_reconfigure::Server<IdentifierConfig>(pnh));
+  reconfigure_->setCallback(
+      [this](IdentifierConfig& c, uint32_t level) { onReconfigure(c, level); });
   diagnostics_.setHardwareID("cvg_bench identifier");
   diagnostics_.add("identifier", this, &IdentifierNode::diagnose);
   last_diag_wall_ = ros::WallTime::now();
@@ -115,14 +118,57 @@ void IdentifierNode::clearBuffer() {
 void IdentifierNode::onTruth(const SimulationTruth::ConstPtr& msg) {
   if (msg->mode != options_.mode && truth_mode_warned_ != msg->mode) {
     truth_mode_warned_ = msg->mode;
-    ROS_WARN("identifier: the simulator runs a %s experiment but this identifier's mode is %s "
-             "(it subscribes to %s): start both with the same mode (mode:=%s, autostart:=%s)",
-             msg->mode.c_str(), options_.mode.c_str(),
-             mode_ == ExperimentMode::kFreeDecay ? "slow" : "sweep",
-             msg->mode == "forced" ? "forced" : "free_decay",
-             msg->mode == "forced" ? "forced" : "free_decay");
+    ROS_WARN(
+        "identifier: the simulator runs a %s experiment but this identifier's mode is %s "
+        "(it subscribes to %s): start both with the same mode (mode:=%s, autostart:=%s)",
+        msg->mode.c_str(), options_.mode.c_str(),
+        mode_ == ExperimentMode::kFreeDecay ? "slow" : "sweep",
+        msg->mode == "forced" ? "forced" : "free_decay",
+        msg->mode == "forced" ? "forced" : "free_decay");
   }
   tracker_.onStartEvent(msg->header.stamp);
+}
+
+void IdentifierNode::onReconfigure(IdentifierConfig& c, uint32_t) {
+  IdentifierNodeOptions next = options_;
+  next.identification.model = c.model;
+  next.identification.method = c.method;
+  next.identification.confidence = c.confidence;
+  next.identification.rls_forgetting = c.rls_forgetting;
+  next.window_s = c.window_s;
+  next.identify_period_s = c.identify_period_s;
+  const std::vector<std::string> problems = next.validate();
+  if (!problems.empty()) {
+    ROS_WARN(
+        "%s",
+        joinProblems("identifier: reconfiguration refused, settings unchanged", problems).c_str());
+    c.model = options_.identification.model;
+    c.method = options_.identification.method;
+    c.confidence = options_.identification.confidence;
+    c.rls_forgetting = options_.identification.rls_forgetting;
+    c.window_s = options_.window_s;
+    c.identify_period_s = options_.identify_period_s;
+    return;
+  }
+  const bool refit = next.identification.model != options_.identification.model ||
+                     next.identification.method != options_.identification.method ||
+                     next.identification.confidence != options_.identification.confidence ||
+                     next.identification.rls_forgetting != options_.identification.rls_forgetting ||
+                     next.window_s != options_.window_s;
+  options_ = next;
+  if (!refit) return;
+  rls_.reset(options_.identification.method == "rls"
+                 ? new StreamingFreeDecayRls(options_.identification)
+                 : nullptr);
+  rls_origin_ = ros::Time();
+  // The buffered data are identified again with the new settings (at once when they stopped).
+  if (!stamps_.empty()) new_data_since_identify_ = true;
+  ROS_INFO(
+      "identifier: reconfigured: model %s, method %s, window %.6g s, forgetting %.6g, "
+      "confidence %.6g, identify_period %.6g s",
+      options_.identification.model.c_str(), options_.identification.method.c_str(),
+      options_.window_s, options_.identification.rls_forgetting, options_.identification.confidence,
+      options_.identify_period_s);
 }
 
 void IdentifierNode::countSequence(uint32_t seq) {
@@ -143,8 +189,8 @@ void IdentifierNode::trackExperiment(const ros::Time& epoch, const ros::Time& st
       try {
         identifyNow(options_.identification);
       } catch (const std::exception& e) {
-        ROS_WARN("identifier: final identification of experiment %u failed: %s",
-                 buffer_experiment_, e.what());
+        ROS_WARN("identifier: final identification of experiment %u failed: %s", buffer_experiment_,
+                 e.what());
       }
     }
     clearBuffer();
@@ -154,9 +200,10 @@ void IdentifierNode::trackExperiment(const ros::Time& epoch, const ros::Time& st
   marker_r_ref_ = 0.0;
   if (b == ExperimentTracker::Boundary::kJumpBack) {
     if (!loop_warned_)
-      ROS_WARN("identifier: %s: experiment %u starts afresh (further jumps are counted in the "
-               "diagnostics, not logged)",
-               ExperimentTracker::describe(b).c_str(), buffer_experiment_);
+      ROS_WARN(
+          "identifier: %s: experiment %u starts afresh (further jumps are counted in the "
+          "diagnostics, not logged)",
+          ExperimentTracker::describe(b).c_str(), buffer_experiment_);
     else
       ROS_DEBUG("identifier: jump back in time, experiment %u", buffer_experiment_);
     loop_warned_ = true;

@@ -70,11 +70,11 @@ void SimulatorNode::onAutostartTimer(const ros::WallTimerEvent&) {
     if (others > 0 && (now - autostart_since_).toSec() > 3.0 &&
         (last_autostart_warning_.isZero() || (now - last_autostart_warning_).toSec() > 5.0)) {
       last_autostart_warning_ = now;
-      ROS_WARN("autostart:=%s waits for a subscriber of %s, but only the %s experiment's topics "
-               "have subscribers: is the identifier's mode %s? (start both with the same mode)",
-               options_.autostart.c_str(), first.getTopic().c_str(),
-               forced ? "free-decay" : "forced", forced ? "free_decay instead of forced"
-                                                        : "forced instead of free_decay");
+      ROS_WARN(
+          "autostart:=%s waits for a subscriber of %s, but only the %s experiment's topics "
+          "have subscribers: is the identifier's mode %s? (start both with the same mode)",
+          options_.autostart.c_str(), first.getTopic().c_str(), forced ? "free-decay" : "forced",
+          forced ? "free_decay instead of forced" : "forced instead of free_decay");
     }
     return;
   }
@@ -100,9 +100,8 @@ bool SimulatorNode::onStartFreeDecay(StartFreeDecay::Request& req, StartFreeDeca
     startFreeDecay(req.duration_s, req.seed > 0 ? static_cast<int>(req.seed) : options_.seed,
                    start);
     res.success = true;
-    res.message = "free decay started: " +
-                  std::to_string(raw_stream_ ? raw_stream_->total() : 0) + " raw samples, " +
-                  std::to_string(slow_.size()) + " slow states";
+    res.message = "free decay started: " + std::to_string(raw_stream_ ? raw_stream_->total() : 0) +
+                  " raw samples, " + std::to_string(slow_.size()) + " slow states";
   } catch (const std::exception& e) {
     res.success = false;
     res.message = e.what();
@@ -204,9 +203,8 @@ void SimulatorNode::beginStreaming(Running what, ExperimentMode mode,
   truth.n_slow_states = static_cast<uint32_t>(slow_.size());
   truth.n_sweep_points = static_cast<uint32_t>(what == Running::kSweep ? sweep_.size() : 0);
   if (what == Running::kFreeDecay)
-    truth.duration_s =
-        std::max(raw_stream_ ? raw_stream_->timeOf(raw_stream_->total() - 1) : 0.0,
-                 slow_.size() ? slow_.t_s.back() : 0.0);
+    truth.duration_s = std::max(raw_stream_ ? raw_stream_->timeOf(raw_stream_->total() - 1) : 0.0,
+                                slow_.size() ? slow_.t_s.back() : 0.0);
   truth_pub_.publish(truth);
 }
 

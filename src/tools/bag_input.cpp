@@ -52,8 +52,8 @@ AnyRecord readRecordInput(const std::string& path, const RecordReadOptions& opti
   slow.slow = demodulateUniform(rec.raw, o);
   slow.slow.source = rec.raw.source;
   slow.slow.omega_rad_s = rec.raw.omega_rad_s;
-  slow.slow.metadata["demodulated"] = "as demodulator_node with " + config + " at " +
-                                      std::to_string(o.output_rate_hz) + " Hz";
+  slow.slow.metadata["demodulated"] =
+      "as demodulator_node with " + config + " at " + std::to_string(o.output_rate_hz) + " Hz";
   return slow;
 #else
   throw InputError(path +

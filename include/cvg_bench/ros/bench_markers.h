@@ -23,9 +23,9 @@ struct BenchView {
   double r_ref = 0.0;      ///< largest r of the experiment (normalises the deformation)
   double theta_rad = 0.0;  ///< pattern angle theta of the latest slow state [rad]
   bool have_axes = false;
-  double alpha_rad = 0.0;  ///< stiffness axis angle [rad]
-  double beta_rad = 0.0;   ///< damping axis angle [rad]
-  std::string panel;       ///< text panel lines
+  double alpha_rad = 0.0;          ///< stiffness axis angle [rad]
+  double beta_rad = 0.0;           ///< damping axis angle [rad]
+  std::string panel;               ///< text panel lines
   double deformation_scale = 0.3;  ///< largest radial deformation drawn [ring radii]
 };
 

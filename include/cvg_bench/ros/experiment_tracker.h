@@ -24,7 +24,7 @@ class ExperimentTracker {
   /// A start event: the next sample stamped at or after `start` begins a new experiment.
   void onStartEvent(const ros::Time& start);
 
-  uint32_t id() const { return id_; }  ///< 0 before the first sample
+  uint32_t id() const { return id_; }                ///< 0 before the first sample
   const ros::Time& start() const { return start_; }  ///< stamp of the experiment's first sample
   uint64_t jumpsBack() const { return jumps_back_; }
   static std::string describe(Boundary b);

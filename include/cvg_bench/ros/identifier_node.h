@@ -14,6 +14,7 @@
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
@@ -21,12 +22,13 @@
 #include <memory>
 #include <string>
 
+#include "cvg_bench/DerivedQuantitiesStamped.h"
 #include "cvg_bench/Explain.h"
 #include "cvg_bench/GetEstimate.h"
+#include "cvg_bench/IdentifierConfig.h"
 #include "cvg_bench/Identify.h"
-#include "cvg_bench/PredictDrift.h"
 #include "cvg_bench/ModelEstimate.h"
-#include "cvg_bench/DerivedQuantitiesStamped.h"
+#include "cvg_bench/PredictDrift.h"
 #include "cvg_bench/Reset.h"
 #include "cvg_bench/SimulationTruth.h"
 #include "cvg_bench/SlowState.h"
@@ -48,8 +50,12 @@ class IdentifierNode {
   void onSlow(const SlowState::ConstPtr& msg);
   void onSweep(const SweepPoint::ConstPtr& msg);
   void onTruth(const SimulationTruth::ConstPtr& msg);
+  /// dynamic_reconfigure (cfg/Identifier.cfg): model, method, window, forgetting factor,
+  /// confidence, streaming period; refused (previous settings kept) when invalid.
+  void onReconfigure(IdentifierConfig& config, uint32_t level);
   void onTimer(const ros::WallTimerEvent&);
-  /// Classifies a sample; on a new experiment finishes the old one's estimate and clears the buffer.
+  /// Classifies a sample; on a new experiment finishes the old one's estimate and clears the
+  /// buffer.
   void trackExperiment(const ros::Time& epoch, const ros::Time& stamp);
   /// Counts samples lost before reaching the callback (publisher sequence numbers skipped).
   void countSequence(uint32_t seq);
@@ -83,6 +89,7 @@ class IdentifierNode {
   tf2_ros::TransformBroadcaster tf_;
   diagnostic_updater::Updater diagnostics_;
   ros::WallTimer diagnostics_timer_;
+  std::unique_ptr<dynamic_reconfigure::Server<IdentifierConfig>> reconfigure_;
 
   // Experiments: the buffer holds experiment buffer_experiment_ (0 = none yet).
   ExperimentTracker tracker_;

@@ -18,8 +18,9 @@ namespace cvg_bench {
 
 class RawFreeDecayStream {
  public:
-  /// duration_s > 0; start.r = 0: from the preset's drive (ExperimentRunner::freeDecayInitialState),
-  /// else from these orbit elements (5.2). InputError on bad input.
+  /// duration_s > 0; start.r = 0: from the preset's drive
+  /// (ExperimentRunner::freeDecayInitialState), else from these orbit elements (5.2). InputError on
+  /// bad input.
   RawFreeDecayStream(const ResonatorPreset& preset, double duration_s, std::uint64_t seed,
                      const OrbitElements& start);
   /// The next at most max_samples samples (t_s from the experiment's start); empty at the end.

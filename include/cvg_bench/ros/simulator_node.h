@@ -19,8 +19,8 @@
 
 #include "cvg_bench/StartFreeDecay.h"
 #include "cvg_bench/StartSweep.h"
-#include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/io/records.h"
+#include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/resonator_preset.h"
 #include "cvg_bench/ros/raw_free_decay_stream.h"
 #include "cvg_bench/ros/simulator_node_options.h"
