@@ -104,14 +104,27 @@ class RvizView(unittest.TestCase):
                 lambda: self.markers is not None and self.estimate is not None
                 and any(m.ns == "panel" for m in self.markers.markers), 40.0),
                 "no estimate and panel marker")
-            time.sleep(6.0)  # rviz (slow to start under software GL) draws the latest markers
-            self.assertIsNone(rviz.poll(), "rviz exited")
+            # rviz takes 10-30 s to show its window under software GL on a loaded machine:
+            # screenshots every 2 s until the markers are drawn (or the deadline).
+            deadline = time.monotonic() + 50.0
             with tempfile.TemporaryDirectory() as tmp:
                 dump = os.path.join(tmp, "root.xwd")
-                subprocess.run(["xwd", "-root", "-silent", "-out", dump], env=env, check=True,
-                               timeout=10)
-                rgb = read_xwd(dump)
-            counts = colour_counts(rgb)
+                while True:
+                    self.assertIsNone(rviz.poll(), "rviz exited")
+                    subprocess.run(["xwd", "-root", "-silent", "-out", dump], env=env, check=True,
+                                   timeout=10)
+                    rgb = read_xwd(dump)
+                    counts = colour_counts(rgb)
+                    if all(counts[k] >= v for k, v in MIN_PIXELS.items()):
+                        time.sleep(2.0)  # one more frame: the screenshot shows the settled view
+                        subprocess.run(["xwd", "-root", "-silent", "-out", dump], env=env,
+                                       check=True, timeout=10)
+                        rgb = read_xwd(dump)
+                        counts = colour_counts(rgb)
+                        break
+                    if time.monotonic() > deadline:
+                        break
+                    time.sleep(2.0)  # screenshot period of the bounded wait
             out = os.environ.get("CVG_SCREENSHOT")
             if out:
                 from PIL import Image
