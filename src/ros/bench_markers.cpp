@@ -50,7 +50,7 @@ visualization_msgs::Marker label(const BenchView& v, int id, double angle, doubl
   visualization_msgs::Marker m =
       base(v, "labels", id, visualization_msgs::Marker::TEXT_VIEW_FACING);
   m.pose.position = point(radius * std::cos(angle), radius * std::sin(angle), z);
-  m.scale.z = 0.14;  // text height
+  m.scale.z = 0.11;  // text height
   m.text = text;
   return m;
 }
@@ -87,7 +87,8 @@ visualization_msgs::MarkerArray benchMarkers(const BenchView& v) {
     visualization_msgs::Marker a = arrow(v, 2, v.theta_rad, 1.15 + amp);
     colour(a, 1.0, 0.85, 0.1);
     out.markers.push_back(a);
-    visualization_msgs::Marker l = label(v, 2, v.theta_rad, 1.45 + amp, 0.0, "wave theta");
+    // Inside the ring: never on the axes' labels outside it.
+    visualization_msgs::Marker l = label(v, 2, v.theta_rad, 0.55, 0.0, "wave theta");
     colour(l, 1.0, 0.85, 0.1);
     out.markers.push_back(l);
   }
@@ -96,21 +97,21 @@ visualization_msgs::MarkerArray benchMarkers(const BenchView& v) {
     visualization_msgs::Marker a = arrow(v, 0, v.alpha_rad, 1.7);
     colour(a, 0.95, 0.3, 0.3);
     out.markers.push_back(a);
-    visualization_msgs::Marker la = label(v, 0, v.alpha_rad, 1.95, 0.25, "stiffness alpha");
+    visualization_msgs::Marker la = label(v, 0, v.alpha_rad, 2.15, 0.0, "stiffness alpha");
     colour(la, 0.95, 0.3, 0.3);
     out.markers.push_back(la);
     visualization_msgs::Marker b = arrow(v, 1, v.beta_rad, 1.45);
     colour(b, 0.3, 0.6, 1.0);
     out.markers.push_back(b);
-    visualization_msgs::Marker lb = label(v, 1, v.beta_rad, 1.7, -0.25, "damping beta");
+    visualization_msgs::Marker lb = label(v, 1, v.beta_rad, 1.7, 0.0, "damping beta");
     colour(lb, 0.3, 0.6, 1.0);
     out.markers.push_back(lb);
   }
   if (!v.panel.empty()) {
     visualization_msgs::Marker p =
         base(v, "panel", 0, visualization_msgs::Marker::TEXT_VIEW_FACING);
-    p.pose.position = point(0.0, -2.6, 0.0);
-    p.scale.z = 0.16;
+    p.pose.position = point(0.0, -1.95, 0.0);
+    p.scale.z = 0.1;
     colour(p, 1.0, 1.0, 1.0);
     p.text = v.panel;
     out.markers.push_back(p);

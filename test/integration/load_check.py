@@ -92,10 +92,13 @@ class LoadCheck(unittest.TestCase):
         def done():
             sim = self.diag.get("sim")
             est = self.estimates.get(experiment_id)
-            return (sim is not None and sim["summary"] == "idle" and est is not None
+            return (sim is not None and sim["summary"] == "idle"
+                    and int(sim["experiments_started"]) == experiment_id and est is not None
+                    and float(self.diag["demod"]["input_rate_samples_per_s"]) == 0.0
+                    and float(self.diag["ident"]["input_rate_hz"]) == 0.0
                     and time.monotonic() - est[1] > 2.0
                     and all(d["wall"] > est[1] + 1.0 for d in self.diag.values()))
-        self.wait(done, 40.0, "experiment %d did not finish and settle" % experiment_id)
+        self.wait(done, 60.0, "experiment %d did not finish and settle" % experiment_id)
         with self.lock:
             return {k: dict(v) for k, v in self.diag.items()}, self.estimates[experiment_id][0]
 
@@ -114,7 +117,7 @@ class LoadCheck(unittest.TestCase):
         sim, demod, ident = diag["sim"], diag["demod"], diag["ident"]
         n_record = math.floor(duration_s * 300000.0) + 1
         self.assertEqual(int(sim["raw_samples_of_record"]), n_record)
-        self.assertEqual(int(sim["raw_samples_published"]), n_record)
+        self.assertEqual(int(sim["raw_samples_published"]), n_record, sim)
         self.assertLessEqual(largest, MAX_BATCH)
         # Every loss counted.
         received_raw = int(demod["raw_samples_received"])
