@@ -235,7 +235,8 @@ void SimulatorNode::publishDueFreeDecay(double due_s) {
       raw_published_ += piece.size();
       ++raw_batches_;
     }
-    lag_s_ = std::max(0.0, due_s - raw_stream_->timeOf(raw_stream_->produced() - 1));
+    const double due_in_record_s = std::min(due_s, raw_stream_->timeOf(raw_stream_->total() - 1));
+    lag_s_ = std::max(0.0, due_in_record_s - raw_stream_->timeOf(raw_stream_->produced() - 1));
     max_lag_s_ = std::max(max_lag_s_, lag_s_);
   }
   for (; slow_next_ < slow_.size() && slow_.t_s[slow_next_] <= due_s; ++slow_next_) {

@@ -121,10 +121,12 @@ class LoadCheck(unittest.TestCase):
         self.assertLessEqual(largest, MAX_BATCH)
         # Every loss counted.
         received_raw = int(demod["raw_samples_received"])
-        if int(demod["batches_lost_in_transport"]) == 0:
-            self.assertEqual(received_raw, n_record)
-        else:
-            self.assertLess(received_raw, n_record)
+        # Sequence gaps count every lost batch but the last ones (no later message shows the
+        # gap): what is missing beyond the counted batches is at most the final two batches.
+        lost = int(demod["batches_lost_in_transport"])
+        self.assertLessEqual(received_raw, n_record)
+        self.assertLessEqual(n_record - received_raw, (lost + 2) * MAX_BATCH)
+        tail_short = n_record - received_raw if lost == 0 else None
         published_slow = int(demod["slow_states_published"])
         self.assertEqual(int(ident["received"]) + int(ident["dropped_in_transport"]), published_slow)
         rss = {k: peak_rss_mb(n) for k, n in NODES.items()}
@@ -136,7 +138,8 @@ class LoadCheck(unittest.TestCase):
             "sustained_raw_samples_per_s": round(n_record / raw_span) if raw_span > 0 else None,
             "simulator_max_lag_s": float(sim["max_lag_s"]),
             "ticks_capped": int(sim["ticks_capped_at_max_batch_samples"]),
-            "demod_batches_lost": int(demod["batches_lost_in_transport"]),
+            "demod_batches_lost": lost,
+            "demod_raw_received": received_raw, "demod_uncounted_tail_samples": tail_short,
             "slow_states_published": published_slow,
             "ident_received": int(ident["received"]),
             "ident_dropped_in_transport": int(ident["dropped_in_transport"]),
