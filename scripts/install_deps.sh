@@ -13,6 +13,9 @@ PACKAGES=(
   libeigen3-dev libceres-dev libboost-dev libboost-math-dev libyaml-cpp-dev nlohmann-json3-dev
   libgtest-dev googletest libbenchmark-dev
   python3-numpy python3-matplotlib python3-yaml
+  libvisualization-msgs-dev python3-visualization-msgs
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
+  rviz xvfb x11-apps
 )
 
 missing=()

@@ -1,16 +1,7 @@
 // Parameter identification on the bench (see include/cvg_bench/ros/identifier_node.h).
-#include <ros/ros.h>
-
 #include "cvg_bench/ros/identifier_node.h"
+#include "cvg_bench/ros/node_runner.h"
 
 int main(int argc, char** argv) {
-  ros::init(argc, argv, "identifier");
-  try {
-    cvg_bench::IdentifierNode node(ros::NodeHandle(), ros::NodeHandle("~"));
-    ros::spin();
-  } catch (const std::exception& e) {
-    ROS_FATAL("identifier: %s", e.what());
-    return 1;
-  }
-  return 0;
+  return cvg_bench::runNode<cvg_bench::IdentifierNode>(argc, argv, "identifier");
 }

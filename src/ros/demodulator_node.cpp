@@ -20,7 +20,7 @@ DemodulatorNode::DemodulatorNode(const ros::NodeHandle& nh, const ros::NodeHandl
   if (options_.omega_rad_s > 0.0 && options_.sample_rate_hz > 0.0)
     configure(options_.omega_rad_s, options_.sample_rate_hz);  // fail at start-up, not later
   slow_pub_ = nh_.advertise<SlowState>("slow", options_.queue_size);
-  raw_sub_ = nh_.subscribe("raw", options_.queue_size, &DemodulatorNode::onRaw, this);
+  raw_sub_ = nh_.subscribe("raw", options_.raw_queue_size, &DemodulatorNode::onRaw, this);
   reset_srv_ = nh_.advertiseService("demodulator/reset", &DemodulatorNode::onReset, this);
   diagnostics_.setHardwareID("cvg_bench demodulator");
   diagnostics_.add("demodulator", this, &DemodulatorNode::diagnose);
@@ -65,6 +65,10 @@ bool DemodulatorNode::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Re
 
 void DemodulatorNode::onRaw(const RawSampleBatch::ConstPtr& msg) {
   ++batches_;
+  samples_in_ += msg->f.size();
+  if (have_seq_ && msg->header.seq > last_seq_) batches_lost_ += msg->header.seq - last_seq_ - 1;
+  have_seq_ = true;
+  last_seq_ = msg->header.seq;
   const ros::Time now = ros::Time::now();
   // A /clock that jumps back (replay restarted) is reported; the reset itself is decided by the
   // data's own stamps below, so a batch processed before the clock message is not reset twice.
@@ -152,13 +156,24 @@ void DemodulatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   }
   if (!demodulator_)
     stat.summary(diagnostic_msgs::DiagnosticStatus::WARN, "waiting for raw batches");
-  else if (rejected > 0 || bad_batches_ > 0)
-    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu samples dropped, %llu bad batches",
+  else if (rejected > 0 || bad_batches_ > 0 || batches_lost_ > 0)
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
+                  "%llu samples dropped, %llu bad batches, %llu batches lost in transport",
                   static_cast<unsigned long long>(rejected),
-                  static_cast<unsigned long long>(bad_batches_));
+                  static_cast<unsigned long long>(bad_batches_),
+                  static_cast<unsigned long long>(batches_lost_));
   else
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "ok");
   for (const auto& kv : counts) stat.add(kv.first, kv.second);
+  const ros::WallTime now = ros::WallTime::now();
+  const double dt = last_diag_wall_.isZero() ? 0.0 : (now - last_diag_wall_).toSec();
+  stat.add("input_rate_samples_per_s",
+           dt > 0.0 ? (samples_in_ - samples_in_at_last_diag_) / dt : 0.0);
+  last_diag_wall_ = now;
+  samples_in_at_last_diag_ = samples_in_;
+  stat.add("raw_samples_received", samples_in_);
+  stat.add("batches_lost_in_transport", batches_lost_);
+  stat.add("raw_queue_size", options_.raw_queue_size);
   stat.add("rejected_total", rejected);
   stat.add("batches", batches_);
   stat.add("bad_batches", bad_batches_);

@@ -12,6 +12,7 @@ std::vector<std::string> DemodulatorNodeOptions::validate() const {
   if (!(warn_throttle_s > 0.0)) p.push_back("warn_throttle_s: must be > 0");
   if (!(backward_jump_s >= 0.0)) p.push_back("backward_jump_s: must be >= 0");
   if (queue_size < 1) p.push_back("queue_size: must be >= 1");
+  if (raw_queue_size < 1) p.push_back("raw_queue_size: must be >= 1");
   // The core filter's own checks need W and the rate. Where the data will supply them, check the
   // other settings with placeholders that pass the W / rate checks (rate 10x W, W well above the
   // output rate); the real values are checked again when the first batch arrives.
@@ -37,6 +38,7 @@ void DemodulatorNodeOptions::load(ParamReader& r) {
   r.get("warn_throttle_s", warn_throttle_s);
   r.get("backward_jump_s", backward_jump_s);
   r.get("queue_size", queue_size);
+  r.get("raw_queue_size", raw_queue_size);
 }
 
 }  // namespace cvg_bench

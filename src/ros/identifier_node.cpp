@@ -4,6 +4,7 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <tf2/LinearMath/Quaternion.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -15,7 +16,9 @@
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/report/explain_json.h"
+#include "cvg_bench/ros/bench_markers.h"
 #include "cvg_bench/ros/conversions.h"
+#include "cvg_bench/ros/estimate_sanity.h"
 
 namespace cvg_bench {
 namespace {
@@ -68,16 +71,26 @@ IdentifierNode::IdentifierNode(const ros::NodeHandle& nh, const ros::NodeHandle&
   estimate_pub_ = nh_.advertise<ModelEstimate>("estimate", 10, /*latch=*/true);
   derived_pub_ = nh_.advertise<DerivedQuantitiesStamped>("derived", 10, /*latch=*/true);
   drift_pub_ = nh_.advertise<DriftRate>("drift", 10);
+  markers_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 2, /*latch=*/true);
   if (mode_ == ExperimentMode::kFreeDecay)
     data_sub_ = nh_.subscribe("slow", options_.queue_size, &IdentifierNode::onSlow, this);
   else
     data_sub_ = nh_.subscribe("sweep", options_.queue_size, &IdentifierNode::onSweep, this);
+  truth_sub_ = nh_.subscribe("truth", 10, &IdentifierNode::onTruth, this);
   identify_srv_ = nh_.advertiseService("identify", &IdentifierNode::onIdentify, this);
   get_estimate_srv_ = nh_.advertiseService("get_estimate", &IdentifierNode::onGetEstimate, this);
   predict_drift_srv_ = nh_.advertiseService("predict_drift", &IdentifierNode::onPredictDrift, this);
   reset_srv_ = nh_.advertiseService("identifier/reset", &IdentifierNode::onReset, this);
   explain_srv_ = nh_.advertiseService("explain", &IdentifierNode::onExplain, this);
   timer_ = nh_.createWallTimer(ros::WallDuration(0.05), &IdentifierNode::onTimer, this);
+  reconfigure_.reset(new dynamic_reconfigure::Server<IdentifierConfig>(pnh));
+  reconfigure_->setCallback(
+      [this](IdentifierConfig& c, uint32_t level) { onReconfigure(c, level); });
+  diagnostics_.setHardwareID("cvg_bench identifier");
+  diagnostics_.add("identifier", this, &IdentifierNode::diagnose);
+  last_diag_wall_ = ros::WallTime::now();
+  diagnostics_timer_ = nh_.createWallTimer(
+      ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { diagnostics_.force_update(); });
   ROS_INFO("identifier: %s, model %s, method %s", options_.mode.c_str(),
            options_.identification.model.c_str(), options_.identification.method.c_str());
 }
@@ -88,6 +101,11 @@ double IdentifierNode::omegaForEstimate() const {
 }
 
 void IdentifierNode::clearData(const std::string& why) {
+  clearBuffer();
+  ROS_WARN("identifier: data cleared: %s", why.c_str());
+}
+
+void IdentifierNode::clearBuffer() {
   stamps_.clear();
   slow_q_.clear();
   sweep_ = SweepRecord();
@@ -95,24 +113,123 @@ void IdentifierNode::clearData(const std::string& why) {
   new_data_since_identify_ = false;
   if (rls_) rls_->reset();
   rls_origin_ = ros::Time();
-  ROS_WARN("identifier: data cleared: %s", why.c_str());
+}
+
+void IdentifierNode::onTruth(const SimulationTruth::ConstPtr& msg) {
+  if (msg->mode != options_.mode && truth_mode_warned_ != msg->mode) {
+    truth_mode_warned_ = msg->mode;
+    ROS_WARN(
+        "identifier: the simulator runs a %s experiment but this identifier's mode is %s "
+        "(it subscribes to %s): start both with the same mode (mode:=%s, autostart:=%s)",
+        msg->mode.c_str(), options_.mode.c_str(),
+        mode_ == ExperimentMode::kFreeDecay ? "slow" : "sweep",
+        msg->mode == "forced" ? "forced" : "free_decay",
+        msg->mode == "forced" ? "forced" : "free_decay");
+  }
+  tracker_.onStartEvent(msg->header.stamp);
+}
+
+void IdentifierNode::onReconfigure(IdentifierConfig& c, uint32_t) {
+  IdentifierNodeOptions next = options_;
+  next.identification.model = c.model;
+  next.identification.method = c.method;
+  next.identification.confidence = c.confidence;
+  next.identification.rls_forgetting = c.rls_forgetting;
+  next.window_s = c.window_s;
+  next.identify_period_s = c.identify_period_s;
+  const std::vector<std::string> problems = next.validate();
+  if (!problems.empty()) {
+    ROS_WARN(
+        "%s",
+        joinProblems("identifier: reconfiguration refused, settings unchanged", problems).c_str());
+    c.model = options_.identification.model;
+    c.method = options_.identification.method;
+    c.confidence = options_.identification.confidence;
+    c.rls_forgetting = options_.identification.rls_forgetting;
+    c.window_s = options_.window_s;
+    c.identify_period_s = options_.identify_period_s;
+    return;
+  }
+  const bool refit = next.identification.model != options_.identification.model ||
+                     next.identification.method != options_.identification.method ||
+                     next.identification.confidence != options_.identification.confidence ||
+                     next.identification.rls_forgetting != options_.identification.rls_forgetting ||
+                     next.window_s != options_.window_s;
+  options_ = next;
+  if (!refit) return;
+  rls_.reset(options_.identification.method == "rls"
+                 ? new StreamingFreeDecayRls(options_.identification)
+                 : nullptr);
+  rls_origin_ = ros::Time();
+  // The buffered data are identified again with the new settings (at once when they stopped).
+  if (!stamps_.empty()) new_data_since_identify_ = true;
+  ROS_INFO(
+      "identifier: reconfigured: model %s, method %s, window %.6g s, forgetting %.6g, "
+      "confidence %.6g, identify_period %.6g s",
+      options_.identification.model.c_str(), options_.identification.method.c_str(),
+      options_.window_s, options_.identification.rls_forgetting, options_.identification.confidence,
+      options_.identify_period_s);
+}
+
+void IdentifierNode::countSequence(uint32_t seq) {
+  ++received_;
+  // Publishers number their messages; a skipped number is a message lost on the way (a full
+  // subscriber queue). A number going back is a restarted publisher or a looped bag.
+  if (have_seq_ && seq > last_seq_) dropped_transport_ += seq - last_seq_ - 1;
+  have_seq_ = true;
+  last_seq_ = seq;
+}
+
+void IdentifierNode::trackExperiment(const ros::Time& epoch, const ros::Time& stamp) {
+  const ExperimentTracker::Boundary b = tracker_.onSample(epoch, stamp);
+  if (b == ExperimentTracker::Boundary::kNone) return;
+  if (buffer_experiment_ > 0) {
+    // Finish the old experiment's estimate from its own data before the buffer is cleared.
+    if (new_data_since_identify_ && static_cast<int>(stamps_.size()) >= options_.min_samples) {
+      try {
+        identifyNow(options_.identification);
+      } catch (const std::exception& e) {
+        ROS_WARN("identifier: final identification of experiment %u failed: %s", buffer_experiment_,
+                 e.what());
+      }
+    }
+    clearBuffer();
+  }
+  buffer_experiment_ = tracker_.id();
+  buffer_experiment_start_ = tracker_.start();
+  marker_r_ref_ = 0.0;
+  if (b == ExperimentTracker::Boundary::kJumpBack) {
+    if (!loop_warned_)
+      ROS_WARN(
+          "identifier: %s: experiment %u starts afresh (further jumps are counted in the "
+          "diagnostics, not logged)",
+          ExperimentTracker::describe(b).c_str(), buffer_experiment_);
+    else
+      ROS_DEBUG("identifier: jump back in time, experiment %u", buffer_experiment_);
+    loop_warned_ = true;
+  } else {
+    ROS_INFO("identifier: experiment %u: %s", buffer_experiment_,
+             ExperimentTracker::describe(b).c_str());
+  }
 }
 
 void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
+  countSequence(msg->header.seq);
   Eigen::Vector4d q;
   try {
     q = slowFromMsg(*msg);
   } catch (const InputError& e) {
     ++dropped_;
+    ++dropped_invalid_;
     ROS_WARN_THROTTLE(5.0, "identifier: slow state dropped (%llu so far): %s",
                       static_cast<unsigned long long>(dropped_), e.what());
     return;
   }
   const ros::Time stamp = msg->header.stamp;
-  if (have_latest_ && stamp < latest_stamp_)
-    clearData("slow states jumped back in time (bag loop?)");
+  trackExperiment(msg->phase_epoch, stamp);
   if (have_latest_ && stamp == latest_stamp_) {
     ++dropped_;
+    ++dropped_duplicate_;
     ROS_WARN_THROTTLE(5.0, "identifier: duplicate slow-state stamp dropped (%llu so far)",
                       static_cast<unsigned long long>(dropped_));
     return;
@@ -126,6 +243,7 @@ void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
           secondsSince(stamps_.back(), stamps_.front()) > options_.window_s)) {
     stamps_.pop_front();
     slow_q_.pop_front();
+    ++trimmed_;
   }
   latest_q_ = q;
   latest_stamp_ = stamp;
@@ -160,12 +278,13 @@ void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
 
 void IdentifierNode::onSweep(const SweepPoint::ConstPtr& msg) {
   const ros::Time stamp = msg->header.stamp;
-  if (have_latest_ && stamp < latest_stamp_)
-    clearData("sweep points jumped back in time (bag loop?)");
+  countSequence(msg->header.seq);
+  trackExperiment(ros::Time(), stamp);
   try {
     appendSweepPoint(*msg, &sweep_);
   } catch (const InputError& e) {
     ++dropped_;
+    ++dropped_invalid_;
     ROS_WARN_THROTTLE(5.0, "identifier: sweep point dropped (%llu so far): %s",
                       static_cast<unsigned long long>(dropped_), e.what());
     return;
@@ -178,6 +297,7 @@ void IdentifierNode::onSweep(const SweepPoint::ConstPtr& msg) {
     if (!sweep_.direction.empty()) sweep_.direction.erase(sweep_.direction.begin());
     if (!sweep_.jump.empty()) sweep_.jump.erase(sweep_.jump.begin());
     stamps_.pop_front();
+    ++trimmed_;
   }
   latest_q_ = sweep_.q.back();
   latest_stamp_ = stamp;
@@ -214,8 +334,19 @@ void IdentifierNode::identifyNow(const PipelineOptions& options) {
     throw InputError("only " + std::to_string(have) +
                      (mode_ == ExperimentMode::kFreeDecay ? " slow states" : " sweep points") +
                      " buffered; min_samples is " + std::to_string(options_.min_samples));
-  const Estimate e = mode_ == ExperimentMode::kFreeDecay ? identify(bufferedSlowRecord(), options)
-                                                         : identify(sweep_, options);
+  const ros::WallTime t0 = ros::WallTime::now();
+  Estimate e;
+  try {
+    e = mode_ == ExperimentMode::kFreeDecay ? identify(bufferedSlowRecord(), options)
+                                            : identify(sweep_, options);
+  } catch (const std::exception& ex) {
+    ++identification_failures_;
+    last_solver_message_ = std::string("failed: ") + ex.what();
+    throw;
+  }
+  last_identify_wall_s_ = (ros::WallTime::now() - t0).toSec();
+  ++identifications_;
+  last_solver_message_ = summary(e, have);
   estimate_ = e;
   window_start_ = stamps_.front();
   window_end_ = stamps_.back();
@@ -253,19 +384,36 @@ void IdentifierNode::onTimer(const ros::WallTimerEvent&) {
 void IdentifierNode::publishEstimate() {
   ModelEstimate msg = estimateToMsg(estimate_, window_start_, window_end_, window_samples_);
   msg.header.frame_id = options_.frame_id;
-  estimate_pub_.publish(msg);
-  if (!estimate_.derived.empty()) {
-    DerivedQuantitiesStamped d = derivedToMsg(estimate_.derived, window_end_, estimate_.confidence,
-                                              options_.identification.angular_gain_k);
-    d.header.frame_id = options_.frame_id;
-    derived_pub_.publish(d);
+  msg.experiment_id = buffer_experiment_;
+  msg.experiment_start = buffer_experiment_start_;
+  msg.sanity_problems = sanityProblems(estimate_);
+  msg.suspect = !msg.sanity_problems.empty();
+  if (msg.suspect) {
+    ++suspect_estimates_;
+    std::string all;
+    for (const auto& p : msg.sanity_problems) all += "; " + p;
+    ROS_WARN_THROTTLE(5.0, "identifier: estimate of experiment %u is suspect%s", buffer_experiment_,
+                      all.c_str());
   }
+  last_sanity_problems_ = msg.sanity_problems;
+  estimate_pub_.publish(msg);
+  DerivedQuantitiesStamped d = derivedToMsg(estimate_.derived, window_end_, estimate_.confidence,
+                                            options_.identification.angular_gain_k);
+  d.header.frame_id = options_.frame_id;
+  if (!estimate_.derived.empty()) derived_pub_.publish(d);
+  if (history_.empty() || history_.back().estimate.experiment_id != msg.experiment_id)
+    history_.emplace_back();
+  history_.back() = {msg, d, summary(estimate_, window_samples_),
+                     estimate_.rank == estimate_.n_params};
+  while (static_cast<int>(history_.size()) > options_.history_size) history_.pop_front();
   if (have_latest_) {
     const OrbitElements o = orbitFromSlow(latest_q_);
     if (std::fabs(o.r * o.r - o.k * o.k) > 1e-12 * (o.r * o.r + 1e-300)) {
       try {
         const ParameterEstimate rate =
             driftRateWithInterval(o.r, o.k, o.theta, uncertainParameters(estimate_));
+        last_drift_rad_s_ = rate;
+        have_drift_ = true;
         DriftRate d = driftRateToMsg(o.r, o.k, o.theta, rate, estimate_.confidence, latest_stamp_);
         d.header.frame_id = options_.frame_id;
         drift_pub_.publish(d);
@@ -296,6 +444,7 @@ void IdentifierNode::publishFrames() {
     axes_pending_ = false;
   }
   last_tf_wall_ = now;
+  publishMarkers();
   if (repeated) {
     tf_.sendTransform(frames);
     return;
@@ -305,6 +454,49 @@ void IdentifierNode::publishFrames() {
     frames.push_back(
         rotationAboutZ(parent, prefix + "wave_pattern", orbitFromSlow(latest_q_).theta, stamp));
   tf_.sendTransform(frames);
+}
+
+void IdentifierNode::publishMarkers() {
+  BenchView v;
+  v.frame_id = options_.frame_id;
+  v.stamp = latest_stamp_;
+  if (have_latest_) {
+    const OrbitElements o = orbitFromSlow(latest_q_);
+    v.have_state = true;
+    v.r = o.r;
+    v.theta_rad = o.theta;
+    marker_r_ref_ = std::max(marker_r_ref_, std::fabs(o.r));
+    v.r_ref = marker_r_ref_;
+  }
+  if (have_estimate_) {
+    const DefectAxes axes = defectAxes(valuesOf(estimate_));
+    v.have_axes = true;
+    v.alpha_rad = axes.alpha;
+    v.beta_rad = axes.beta;
+    std::ostringstream t;
+    t.precision(4);
+    const auto line = [&](const char* label, const char* key, double scale, const char* unit) {
+      const auto it = estimate_.derived.find(key);
+      if (it == estimate_.derived.end()) return;
+      t << label << " = " << it->second.value * scale << " [" << it->second.ci_low * scale << ", "
+        << it->second.ci_high * scale << "]" << unit << "\n";
+    };
+    t << "experiment " << buffer_experiment_ << ", " << window_samples_ << " samples, "
+      << estimate_.method << " " << estimate_.model << "\n";
+    line("Q", "Q", 1.0, "");
+    line("split", "frequency_split_hz", 1.0, " Hz");
+    if (have_drift_)
+      t << "drift = " << last_drift_rad_s_.value * 180 / M_PI << " ["
+        << last_drift_rad_s_.ci_low * 180 / M_PI << ", " << last_drift_rad_s_.ci_high * 180 / M_PI
+        << "] deg/s\n";
+    if (v.have_state)
+      t << "r = " << v.r << " (" << 100.0 * std::fabs(v.r) / std::max(v.r_ref, 1e-300)
+        << " % of the start), theta = " << v.theta_rad * 180 / M_PI << " deg\n";
+    t << estimate_.confidence * 100 << " % intervals";
+    if (!last_sanity_problems_.empty()) t << "\nSUSPECT: " << last_sanity_problems_.front();
+    v.panel = t.str();
+  }
+  markers_pub_.publish(benchMarkers(v));
 }
 
 bool IdentifierNode::onIdentify(Identify::Request& req, Identify::Response& res) {
@@ -330,7 +522,24 @@ bool IdentifierNode::onIdentify(Identify::Request& req, Identify::Response& res)
   return true;
 }
 
-bool IdentifierNode::onGetEstimate(GetEstimate::Request&, GetEstimate::Response& res) {
+bool IdentifierNode::onGetEstimate(GetEstimate::Request& req, GetEstimate::Response& res) {
+  if (req.experiment_id != 0) {
+    for (const StoredEstimate& h : history_)
+      if (h.estimate.experiment_id == req.experiment_id) {
+        res.success = h.full_rank;
+        res.message = "experiment " + std::to_string(req.experiment_id) + ": " + h.summary;
+        res.estimate = h.estimate;
+        res.derived = h.derived;
+        return true;
+      }
+    res.success = false;
+    std::string kept;
+    for (const StoredEstimate& h : history_)
+      kept += (kept.empty() ? "" : ", ") + std::to_string(h.estimate.experiment_id);
+    res.message = "no estimate of experiment " + std::to_string(req.experiment_id) +
+                  " (kept: " + (kept.empty() ? "none" : kept) + ")";
+    return true;
+  }
   if (!have_estimate_) {
     res.success = false;
     res.message = "no estimate yet (" + std::to_string(stamps_.size()) + " samples buffered)";
@@ -340,9 +549,51 @@ bool IdentifierNode::onGetEstimate(GetEstimate::Request&, GetEstimate::Response&
   res.message = summary(estimate_, window_samples_);
   res.estimate = estimateToMsg(estimate_, window_start_, window_end_, window_samples_);
   res.estimate.header.frame_id = options_.frame_id;
+  if (!history_.empty()) {
+    res.estimate.experiment_id = history_.back().estimate.experiment_id;
+    res.estimate.experiment_start = history_.back().estimate.experiment_start;
+  }
+  res.estimate.sanity_problems = sanityProblems(estimate_);
+  res.estimate.suspect = !res.estimate.sanity_problems.empty();
   res.derived = derivedToMsg(estimate_.derived, window_end_, estimate_.confidence,
                              options_.identification.angular_gain_k);
   return true;
+}
+
+void IdentifierNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const ros::WallTime now = ros::WallTime::now();
+  const double dt = (now - last_diag_wall_).toSec();
+  const double rate = dt > 0.0 ? (received_ - received_at_last_diag_) / dt : 0.0;
+  last_diag_wall_ = now;
+  received_at_last_diag_ = received_;
+  const uint64_t drops = dropped_invalid_ + dropped_duplicate_ + dropped_transport_;
+  if (!last_sanity_problems_.empty())
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "estimate of experiment %u suspect: %s",
+                  buffer_experiment_, last_sanity_problems_.front().c_str());
+  else if (drops > 0)
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN, "%llu inputs dropped",
+                  static_cast<unsigned long long>(drops));
+  else if (received_ == 0)
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "waiting for data");
+  else
+    stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "ok");
+  stat.add("input_rate_hz", rate);
+  stat.add("received", received_);
+  stat.add("dropped_invalid", dropped_invalid_);
+  stat.add("dropped_duplicate_stamp", dropped_duplicate_);
+  stat.add("dropped_in_transport", dropped_transport_);
+  stat.add("trimmed_oldest", trimmed_);
+  stat.add("buffer_depth", stamps_.size());
+  stat.add("buffer_capacity", options_.max_samples);
+  stat.add("experiment_id", buffer_experiment_);
+  stat.add("jumps_back_in_time", tracker_.jumpsBack());
+  stat.add("identifications", identifications_);
+  stat.add("identification_failures", identification_failures_);
+  stat.add("last_identification_wall_s", last_identify_wall_s_);
+  stat.add("solver", last_solver_message_);
+  stat.add("suspect_estimates", suspect_estimates_);
+  for (size_t i = 0; i < last_sanity_problems_.size(); ++i)
+    stat.add("sanity_problem_" + std::to_string(i + 1), last_sanity_problems_[i]);
 }
 
 bool IdentifierNode::onPredictDrift(PredictDrift::Request& req, PredictDrift::Response& res) {

@@ -30,6 +30,7 @@ std::vector<std::string> IdentifierNodeOptions::validate() const {
   if (!(rls_publish_period_s >= 0.0)) p.push_back("rls_publish_period_s: must be >= 0");
   if (frame_id.empty()) p.push_back("frame_id: must not be empty");
   if (queue_size < 1) p.push_back("queue_size: must be >= 1");
+  if (history_size < 1) p.push_back("history_size: must be >= 1");
   return p;
 }
 
@@ -52,6 +53,7 @@ void IdentifierNodeOptions::load(ParamReader& r) {
   r.get("frame_id", frame_id);
   r.get("child_frame_prefix", child_frame_prefix);
   r.get("queue_size", queue_size);
+  r.get("history_size", history_size);
 }
 
 }  // namespace cvg_bench

@@ -2,6 +2,7 @@
 #include "cvg_bench/ros/simulator_node.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "cvg_bench/RawSampleBatch.h"
 #include "cvg_bench/SimulationTruth.h"
@@ -44,23 +45,45 @@ SimulatorNode::SimulatorNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
                                &SimulatorNode::onTick, this);
   ROS_INFO("resonator simulator: preset '%s' (%s), omega = %.6g rad/s", preset_.name.c_str(),
            preset_.description.c_str(), preset_.omega_rad_s);
+  diagnostics_.setHardwareID("cvg_bench resonator_simulator");
+  diagnostics_.add("resonator_simulator", this, &SimulatorNode::diagnose);
+  last_diag_wall_ = ros::WallTime::now();
+  diagnostics_timer_ = nh_.createWallTimer(
+      ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { diagnostics_.force_update(); });
   if (options_.autostart != "none") {
     // Start once the first consumer is connected (nodes of a launch file come up in any order);
     // start_delay_s then leaves the rest of the chain time to connect.
+    autostart_since_ = ros::WallTime::now();
     autostart_timer_ =
-        nh_.createWallTimer(ros::WallDuration(0.05), [this](const ros::WallTimerEvent&) {
-          const ros::Publisher& first = options_.autostart == "forced" ? sweep_pub_
-                                        : options_.publish_raw         ? raw_pub_
-                                                                       : slow_pub_;
-          if (first.getNumSubscribers() == 0) return;
-          autostart_timer_.stop();
-          try {
-            if (options_.autostart == "free_decay") startFreeDecay(0.0, options_.seed);
-            if (options_.autostart == "forced") startSweep(preset_, options_.seed);
-          } catch (const std::exception& e) {
-            ROS_ERROR("autostart failed: %s", e.what());
-          }
-        });
+        nh_.createWallTimer(ros::WallDuration(0.05), &SimulatorNode::onAutostartTimer, this);
+  }
+}
+
+void SimulatorNode::onAutostartTimer(const ros::WallTimerEvent&) {
+  const bool forced = options_.autostart == "forced";
+  const ros::Publisher& first = forced ? sweep_pub_ : options_.publish_raw ? raw_pub_ : slow_pub_;
+  if (first.getNumSubscribers() == 0) {
+    const uint32_t others = forced ? raw_pub_.getNumSubscribers() + slow_pub_.getNumSubscribers()
+                                   : sweep_pub_.getNumSubscribers();
+    // Warned after 3 s of waiting, then every 5 s while the mismatch lasts.
+    const ros::WallTime now = ros::WallTime::now();
+    if (others > 0 && (now - autostart_since_).toSec() > 3.0 &&
+        (last_autostart_warning_.isZero() || (now - last_autostart_warning_).toSec() > 5.0)) {
+      last_autostart_warning_ = now;
+      ROS_WARN(
+          "autostart:=%s waits for a subscriber of %s, but only the %s experiment's topics "
+          "have subscribers: is the identifier's mode %s? (start both with the same mode)",
+          options_.autostart.c_str(), first.getTopic().c_str(), forced ? "free-decay" : "forced",
+          forced ? "free_decay instead of forced" : "forced instead of free_decay");
+    }
+    return;
+  }
+  autostart_timer_.stop();
+  try {
+    if (options_.autostart == "free_decay") startFreeDecay(0.0, options_.seed);
+    if (forced) startSweep(preset_, options_.seed);
+  } catch (const std::exception& e) {
+    ROS_ERROR("autostart failed: %s", e.what());
   }
 }
 
@@ -77,8 +100,8 @@ bool SimulatorNode::onStartFreeDecay(StartFreeDecay::Request& req, StartFreeDeca
     startFreeDecay(req.duration_s, req.seed > 0 ? static_cast<int>(req.seed) : options_.seed,
                    start);
     res.success = true;
-    res.message = "free decay started: " + std::to_string(raw_.size()) + " raw samples, " +
-                  std::to_string(slow_.size()) + " slow states";
+    res.message = "free decay started: " + std::to_string(raw_stream_ ? raw_stream_->total() : 0) +
+                  " raw samples, " + std::to_string(slow_.size()) + " slow states";
   } catch (const std::exception& e) {
     res.success = false;
     res.message = e.what();
@@ -110,21 +133,22 @@ bool SimulatorNode::onStartSweep(StartSweep::Request& req, StartSweep::Response&
 void SimulatorNode::startFreeDecay(double duration_s, int seed, const OrbitElements& start) {
   requireFinite(duration_s, "duration_s");
   if (duration_s < 0.0) throw InputError("duration_s must be >= 0");
+  if (duration_s > options_.max_duration_s)
+    throw InputError("duration_s = " + std::to_string(duration_s) + " s exceeds max_duration_s = " +
+                     std::to_string(options_.max_duration_s) + " s");
   running_ = Running::kNone;
   const double duration = duration_s > 0.0 ? duration_s : options_.duration_s;
   SimulationOptions sim;
   sim.mode = ExperimentMode::kFreeDecay;
   sim.seed = static_cast<std::uint64_t>(seed);
   sim.free_decay_start = start;
-  raw_ = RawRecord();
+  raw_stream_.reset();
   slow_ = SlowRecord();
   slow_truth_ = SlowRecord();
   sweep_ = SweepRecord();
-  if (options_.publish_raw) {
-    sim.raw = true;
-    sim.duration_s = duration;
-    raw_ = simulateExperiment(preset_, sim).raw;
-  }
+  if (options_.publish_raw)
+    raw_stream_.reset(new RawFreeDecayStream(
+        preset_, duration > 0.0 ? duration : preset_.decay_raw_duration_s, sim.seed, start));
   if (options_.publish_slow) {
     sim.raw = false;
     // The slow record covers the raw record's span when both are published.
@@ -135,15 +159,15 @@ void SimulatorNode::startFreeDecay(double duration_s, int seed, const OrbitEleme
     slow_truth_ = simulateExperiment(preset_, sim).slow;
   }
   beginStreaming(Running::kFreeDecay, ExperimentMode::kFreeDecay, preset_);
-  ROS_INFO("free decay started (seed %d): %zu raw samples, %zu slow states", seed, raw_.size(),
-           slow_.size());
+  ROS_INFO("free decay started (seed %d): %zu raw samples, %zu slow states", seed,
+           raw_stream_ ? raw_stream_->total() : size_t(0), slow_.size());
 }
 
 void SimulatorNode::startSweep(const ResonatorPreset& preset, int seed) {
   running_ = Running::kNone;
   const ExperimentRunner runner(preset);
   const SweepResult result = runner.forcedSweep();
-  raw_ = RawRecord();
+  raw_stream_.reset();
   slow_ = SlowRecord();
   slow_truth_ = SlowRecord();
   sweep_ = sweepRecordOf(result, preset.omega_rad_s);
@@ -158,7 +182,9 @@ void SimulatorNode::startSweep(const ResonatorPreset& preset, int seed) {
 
 void SimulatorNode::beginStreaming(Running what, ExperimentMode mode,
                                    const ResonatorPreset& preset) {
-  raw_next_ = slow_next_ = sweep_next_ = 0;
+  slow_next_ = sweep_next_ = 0;
+  lag_s_ = 0.0;
+  ++experiments_;
   start_stamp_ = ros::Time::now() + ros::Duration(options_.start_delay_s);
   wall_start_ = ros::WallTime::now() + ros::WallDuration(options_.start_delay_s);
   running_ = what;
@@ -173,12 +199,12 @@ void SimulatorNode::beginStreaming(Running what, ExperimentMode mode,
   truth.raw_noise_std = preset.noise_fg_std;
   truth.slow_noise_std = preset.noise_q_std;
   truth.raw_sample_rate_hz = preset.raw_sample_rate_hz;
-  truth.n_raw_samples = static_cast<uint32_t>(raw_.size());
+  truth.n_raw_samples = static_cast<uint32_t>(raw_stream_ ? raw_stream_->total() : 0);
   truth.n_slow_states = static_cast<uint32_t>(slow_.size());
   truth.n_sweep_points = static_cast<uint32_t>(what == Running::kSweep ? sweep_.size() : 0);
   if (what == Running::kFreeDecay)
-    truth.duration_s =
-        std::max(raw_.size() ? raw_.t_s.back() : 0.0, slow_.size() ? slow_.t_s.back() : 0.0);
+    truth.duration_s = std::max(raw_stream_ ? raw_stream_->timeOf(raw_stream_->total() - 1) : 0.0,
+                                slow_.size() ? slow_.t_s.back() : 0.0);
   truth_pub_.publish(truth);
 }
 
@@ -191,17 +217,27 @@ void SimulatorNode::onTick(const ros::WallTimerEvent&) {
 }
 
 void SimulatorNode::publishDueFreeDecay(double due_s) {
-  if (raw_next_ < raw_.size()) {
-    size_t end = raw_next_;
-    while (end < raw_.size() && raw_.t_s[end] <= due_s) ++end;
-    if (end > raw_next_) {
+  const bool raw_done = !raw_stream_ || raw_stream_->produced() >= raw_stream_->total();
+  if (!raw_done) {
+    // Samples with t <= due_s are due; at most max_batch_samples of them now.
+    const double rate = raw_stream_->sampleRateHz();
+    const size_t due = std::min(raw_stream_->total(),
+                                static_cast<size_t>(std::floor(due_s * rate * (1 + 1e-12))) + 1);
+    if (due > raw_stream_->produced()) {
+      const size_t cap = static_cast<size_t>(options_.max_batch_samples);
+      if (due - raw_stream_->produced() > cap) ++capped_ticks_;
+      const RawRecord piece = raw_stream_->next(cap);
       RawSampleBatch batch =
-          rawBatchToMsg(raw_, raw_next_, end, start_stamp_, preset_.raw_sample_rate_hz);
+          rawBatchToMsg(piece, 0, piece.size(), start_stamp_, preset_.raw_sample_rate_hz);
       batch.header.frame_id = options_.frame_id;
       batch.omega_rad_s = preset_.omega_rad_s;
       raw_pub_.publish(batch);
-      raw_next_ = end;
+      raw_published_ += piece.size();
+      ++raw_batches_;
     }
+    const double due_in_record_s = std::min(due_s, raw_stream_->timeOf(raw_stream_->total() - 1));
+    lag_s_ = std::max(0.0, due_in_record_s - raw_stream_->timeOf(raw_stream_->produced() - 1));
+    max_lag_s_ = std::max(max_lag_s_, lag_s_);
   }
   for (; slow_next_ < slow_.size() && slow_.t_s[slow_next_] <= due_s; ++slow_next_) {
     const ros::Time stamp = timeAfter(start_stamp_, slow_.t_s[slow_next_]);
@@ -214,8 +250,10 @@ void SimulatorNode::publishDueFreeDecay(double due_s) {
       t.header.frame_id = options_.frame_id;
       slow_truth_pub_.publish(t);
     }
+    ++slow_published_;
   }
-  if (raw_next_ >= raw_.size() && slow_next_ >= slow_.size()) {
+  if ((!raw_stream_ || raw_stream_->produced() >= raw_stream_->total()) &&
+      slow_next_ >= slow_.size()) {
     running_ = Running::kNone;
     ROS_INFO("free decay finished (%.6g s simulated)", due_s);
   }
@@ -228,11 +266,43 @@ void SimulatorNode::publishDueSweep(double wall_elapsed_s) {
     p.settled = settled_[sweep_next_];
     p.header.frame_id = options_.frame_id;
     sweep_pub_.publish(p);
+    ++sweep_published_;
   }
   if (sweep_next_ >= sweep_.size()) {
     running_ = Running::kNone;
     ROS_INFO("forced sweep finished (%zu points)", sweep_.size());
   }
+}
+
+void SimulatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  const ros::WallTime now = ros::WallTime::now();
+  const double dt = (now - last_diag_wall_).toSec();
+  const double raw_rate = dt > 0.0 ? (raw_published_ - raw_at_last_diag_) / dt : 0.0;
+  last_diag_wall_ = now;
+  raw_at_last_diag_ = raw_published_;
+  const char* state = running_ == Running::kFreeDecay ? "free decay"
+                      : running_ == Running::kSweep   ? "forced sweep"
+                                                      : "idle";
+  // Behind by more than two ticks of simulated time: the requested real-time factor is not met.
+  const double tick_s = options_.realtime_factor / options_.publish_rate_hz;
+  if (running_ == Running::kFreeDecay && lag_s_ > 2.0 * tick_s)
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::WARN,
+                  "%s: %.3g s of simulated time behind realtime_factor %.3g", state, lag_s_,
+                  options_.realtime_factor);
+  else
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::OK, "%s", state);
+  stat.add("experiments_started", experiments_);
+  stat.add("raw_output_rate_hz", raw_rate);
+  stat.add("raw_samples_published", raw_published_);
+  stat.add("raw_batches_published", raw_batches_);
+  stat.add("raw_samples_of_record", raw_stream_ ? raw_stream_->total() : 0);
+  stat.add("ticks_capped_at_max_batch_samples", capped_ticks_);
+  stat.add("lag_s", lag_s_);
+  stat.add("max_lag_s", max_lag_s_);
+  stat.add("slow_states_published", slow_published_);
+  stat.add("sweep_points_published", sweep_published_);
+  stat.add("raw_subscribers", raw_pub_.getNumSubscribers());
+  stat.add("realtime_factor", options_.realtime_factor);
 }
 
 }  // namespace cvg_bench

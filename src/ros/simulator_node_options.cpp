@@ -8,6 +8,9 @@ std::vector<std::string> SimulatorNodeOptions::validate() const {
   if (autostart != "free_decay" && autostart != "forced" && autostart != "none")
     p.push_back("autostart: must be free_decay, forced or none, got '" + autostart + "'");
   if (!(duration_s >= 0.0)) p.push_back("duration_s: must be >= 0");
+  if (!(max_duration_s > 0.0)) p.push_back("max_duration_s: must be > 0");
+  if (duration_s > max_duration_s) p.push_back("duration_s: must not exceed max_duration_s");
+  if (max_batch_samples < 1000) p.push_back("max_batch_samples: must be >= 1000");
   if (!(realtime_factor > 0.0 && realtime_factor <= 1000.0))
     p.push_back("realtime_factor: must be in (0, 1000]");
   if (!(publish_rate_hz >= 1.0 && publish_rate_hz <= 1000.0))
@@ -36,6 +39,8 @@ void SimulatorNodeOptions::load(ParamReader& r) {
   r.get("sweep_point_interval_s", sweep_point_interval_s);
   r.get("seed", seed);
   r.get("noise_scale", noise_scale);
+  r.get("max_duration_s", max_duration_s);
+  r.get("max_batch_samples", max_batch_samples);
   r.get("frame_id", frame_id);
 }
 

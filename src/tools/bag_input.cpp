@@ -3,7 +3,9 @@
 
 #include "cvg_bench/core/model/errors.h"
 #ifdef CVG_WITH_ROSBAG
+#include "cvg_bench/core/demod/demodulator.h"
 #include "cvg_bench/ros/bag_record_reader.h"
+#include "cvg_bench/ros/demodulator_node_options.h"
 #endif
 
 namespace cvg_bench {
@@ -30,7 +32,29 @@ AnyRecord readRecordInput(const std::string& path, const RecordReadOptions& opti
   bag_options.topic = topic;
   bag_options.kinds = kinds;
   bag_options.repair_raw_timestamps = options.repair_raw_timestamps;
-  return readRecordBag(path, bag_options);
+  AnyRecord rec = readRecordBag(path, bag_options);
+  bool wants_slow = false;
+  for (RecordKind k : kinds) wants_slow = wants_slow || k == RecordKind::kFreeDecay;
+  if (rec.kind != RecordKind::kRaw || !wants_slow) return rec;
+  // Offline = live: a raw bag is demodulated as demodulator_node does, with the shipped node
+  // settings (config/demodulator.yaml: output rate, filter) and the bag's reference frequency.
+  const std::string config = std::string(CVG_BENCH_SOURCE_DIR) + "/config/demodulator.yaml";
+  ParamReader reader = ParamReader::fromYamlFile(config);
+  const DemodulatorNodeOptions node = loadOptions<DemodulatorNodeOptions>(reader);
+  DemodulatorOptions o = node.filter;
+  o.omega_rad_s = node.omega_rad_s > 0.0 ? node.omega_rad_s : rec.raw.omega_rad_s;
+  const SamplingSummary sampling = summarizeSampling(rec.raw.t_s);
+  o.sample_rate_hz =
+      node.sample_rate_hz > 0.0 ? node.sample_rate_hz : 1.0 / sampling.median_interval_s;
+  if (!(o.omega_rad_s > 0.0) || !sampling.uniform) return rec;  // the subcommand's own path
+  AnyRecord slow;
+  slow.kind = RecordKind::kFreeDecay;
+  slow.slow = demodulateUniform(rec.raw, o);
+  slow.slow.source = rec.raw.source;
+  slow.slow.omega_rad_s = rec.raw.omega_rad_s;
+  slow.slow.metadata["demodulated"] =
+      "as demodulator_node with " + config + " at " + std::to_string(o.output_rate_hz) + " Hz";
+  return slow;
 #else
   throw InputError(path +
                    ": this build of cvg_ident has no rosbag support (core-only build); "

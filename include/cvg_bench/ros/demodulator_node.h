@@ -59,6 +59,11 @@ class DemodulatorNode {
   uint64_t warned_rejected_ = 0;  ///< rejected count at the last warning
   uint64_t batches_ = 0, slow_published_ = 0, node_resets_ = 0, bad_batches_ = 0;
   std::string last_problem_;
+  // Input accounting: batches lost before the callback (publisher sequence numbers skipped).
+  bool have_seq_ = false;
+  uint32_t last_seq_ = 0;
+  uint64_t batches_lost_ = 0, samples_in_ = 0, samples_in_at_last_diag_ = 0;
+  ros::WallTime last_diag_wall_;
 };
 
 }  // namespace cvg_bench

@@ -26,6 +26,9 @@ struct DemodulatorNodeOptions {
   double backward_jump_s = 0.0;
   /// Subscriber and publisher queue lengths, >= 1.
   int queue_size = 1000;
+  /// Queue length of the raw subscription [batches], >= 1: a short queue bounds the memory when
+  /// the input outruns the node (the oldest batches are dropped and counted).
+  int raw_queue_size = 100;
 
   std::vector<std::string> validate() const;
   void load(ParamReader& reader);

@@ -6,9 +6,15 @@
 // and `drift` ((5.9) at the latest slow state's orbit elements), and broadcasts tf frames rotated
 // about z from `frame_id`: the stiffness axis (alpha), the damping axis (beta) and the wave pattern
 // (theta of the latest slow state, orbitFromSlow). Services: identify, get_estimate, predict_drift,
-// identifier/reset, explain. Data that jump back in time (bag loop) clear the buffer.
+// identifier/reset, explain. Each experiment (ExperimentTracker: new phase epoch, data jumping back
+// in time, the simulator's start event on `truth`) starts a fresh buffer and estimate; the last
+// history_size experiments' estimates stay retrievable (get_estimate by experiment_id). Every
+// published estimate carries its experiment id and its sanity problems (estimate_sanity.h).
+// Diagnostics (1 Hz): input rate, drops by reason, buffer depth, experiment, solver state.
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
 #include <ros/ros.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -17,15 +23,20 @@
 #include <memory>
 #include <string>
 
+#include "cvg_bench/DerivedQuantitiesStamped.h"
 #include "cvg_bench/Explain.h"
 #include "cvg_bench/GetEstimate.h"
+#include "cvg_bench/IdentifierConfig.h"
 #include "cvg_bench/Identify.h"
+#include "cvg_bench/ModelEstimate.h"
 #include "cvg_bench/PredictDrift.h"
+#include "cvg_bench/SimulationTruth.h"
 #include "cvg_bench/SlowState.h"
 #include "cvg_bench/SweepPoint.h"
 #include "cvg_bench/core/estimate/estimate.h"
 #include "cvg_bench/core/estimate/identify_pipeline.h"
 #include "cvg_bench/core/io/records.h"
+#include "cvg_bench/ros/experiment_tracker.h"
 #include "cvg_bench/ros/identifier_node_options.h"
 #include "cvg_bench/ros/streaming_free_decay_rls.h"
 
@@ -39,7 +50,17 @@ class IdentifierNode {
  private:
   void onSlow(const SlowState::ConstPtr& msg);
   void onSweep(const SweepPoint::ConstPtr& msg);
+  void onTruth(const SimulationTruth::ConstPtr& msg);
+  /// dynamic_reconfigure (cfg/Identifier.cfg): model, method, window, forgetting factor,
+  /// confidence, streaming period; refused (previous settings kept) when invalid.
+  void onReconfigure(IdentifierConfig& config, uint32_t level);
   void onTimer(const ros::WallTimerEvent&);
+  /// Classifies a sample; on a new experiment finishes the old one's estimate and clears the
+  /// buffer.
+  void trackExperiment(const ros::Time& epoch, const ros::Time& stamp);
+  /// Counts samples lost before reaching the callback (publisher sequence numbers skipped).
+  void countSequence(uint32_t seq);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   bool onIdentify(Identify::Request& req, Identify::Response& res);
   bool onGetEstimate(GetEstimate::Request& req, GetEstimate::Response& res);
   bool onPredictDrift(PredictDrift::Request& req, PredictDrift::Response& res);
@@ -54,20 +75,57 @@ class IdentifierNode {
   /// streams already).
   void identifyNow(const IdentificationOptions& options);
   void clearData(const std::string& why);
+  void clearBuffer();
   /// The buffered window as a core record (t from the first buffered stamp).
   SlowRecord bufferedSlowRecord() const;
   void publishEstimate();
   void publishFrames();
+  /// rviz markers (bench_markers.h): standing wave, axes, text panel.
+  void publishMarkers();
   double omegaForEstimate() const;
 
   ros::NodeHandle nh_;
   IdentifierNodeOptions options_;
   ExperimentMode mode_;
-  ros::Subscriber data_sub_;
-  ros::Publisher estimate_pub_, derived_pub_, drift_pub_;
+  ros::Subscriber data_sub_, truth_sub_;
+  ros::Publisher estimate_pub_, derived_pub_, drift_pub_, markers_pub_;
   ros::ServiceServer identify_srv_, get_estimate_srv_, predict_drift_srv_, reset_srv_, explain_srv_;
   ros::WallTimer timer_;
   tf2_ros::TransformBroadcaster tf_;
+  diagnostic_updater::Updater diagnostics_;
+  ros::WallTimer diagnostics_timer_;
+  std::unique_ptr<dynamic_reconfigure::Server<IdentifierConfig>> reconfigure_;
+
+  // Experiments: the buffer holds experiment buffer_experiment_ (0 = none yet).
+  ExperimentTracker tracker_;
+  uint32_t buffer_experiment_ = 0;
+  ros::Time buffer_experiment_start_;
+  bool loop_warned_ = false;
+  std::string truth_mode_warned_;
+  /// Last estimate of each of the last history_size experiments, oldest first.
+  struct StoredEstimate {
+    ModelEstimate estimate;
+    DerivedQuantitiesStamped derived;
+    std::string summary;
+    bool full_rank = false;
+  };
+  std::deque<StoredEstimate> history_;
+
+  // Counters (diagnostics).
+  uint64_t received_ = 0, received_at_last_diag_ = 0;
+  ros::WallTime last_diag_wall_;
+  uint64_t dropped_invalid_ = 0, dropped_duplicate_ = 0, dropped_transport_ = 0, trimmed_ = 0;
+  bool have_seq_ = false;
+  uint32_t last_seq_ = 0;
+  uint64_t identifications_ = 0, identification_failures_ = 0, suspect_estimates_ = 0;
+  double last_identify_wall_s_ = 0.0;
+  std::string last_solver_message_ = "no identification yet";
+  std::vector<std::string> last_sanity_problems_;
+
+  // rviz view.
+  double marker_r_ref_ = 0.0;  ///< largest amplitude r of the experiment
+  bool have_drift_ = false;
+  ParameterEstimate last_drift_rad_s_;
 
   // Free decay buffer (stamps exact; q per stamp).
   std::deque<ros::Time> stamps_;

@@ -37,6 +37,8 @@ struct IdentifierNodeOptions {
   /// Prefix of the child frames: <prefix>stiffness_axis, <prefix>damping_axis,
   /// <prefix>wave_pattern.
   std::string child_frame_prefix = "";
+  /// Experiments whose last estimate stays retrievable (get_estimate by experiment_id), >= 1.
+  int history_size = 10;
   /// Queue length of the subscriptions, >= 1.
   int queue_size = 1000;
 

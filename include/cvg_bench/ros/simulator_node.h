@@ -6,16 +6,23 @@
 //   sweep           SweepPoint      settled points of a forced sweep, with noise
 //   truth           SimulationTruth latched: preset, true parameters, noise levels
 // Services start_free_decay and start_sweep start an experiment (the previous one stops).
-// Stamps are start + simulated time; the start is the phase epoch of (2.4).
+// Stamps are start + simulated time; the start is the phase epoch of (2.4). The raw record is
+// produced piece by piece as it becomes due (RawFreeDecayStream), at most max_batch_samples a
+// tick: a node that cannot keep up lags (reported in the diagnostics) instead of growing.
+// Diagnostics (1 Hz): state, published rates, lag behind the requested real-time factor.
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
+
+#include <memory>
 
 #include "cvg_bench/StartFreeDecay.h"
 #include "cvg_bench/StartSweep.h"
-#include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/io/records.h"
+#include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/resonator_preset.h"
+#include "cvg_bench/ros/raw_free_decay_stream.h"
 #include "cvg_bench/ros/simulator_node_options.h"
 
 namespace cvg_bench {
@@ -38,6 +45,10 @@ class SimulatorNode {
   void onTick(const ros::WallTimerEvent&);
   void publishDueFreeDecay(double due_s);
   void publishDueSweep(double wall_elapsed_s);
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
+  /// Autostart: starts once the experiment's first consumer is connected; warns once when only
+  /// consumers of the other experiment's topic are (mode / autostart mismatch), every 5 s.
+  void onAutostartTimer(const ros::WallTimerEvent&);
 
   ros::NodeHandle nh_;
   SimulatorNodeOptions options_;
@@ -48,11 +59,19 @@ class SimulatorNode {
   ros::WallTimer timer_, autostart_timer_;
 
   Running running_ = Running::kNone;
-  RawRecord raw_;
+  std::unique_ptr<RawFreeDecayStream> raw_stream_;
+  diagnostic_updater::Updater diagnostics_;
+  ros::WallTimer diagnostics_timer_;
+  ros::WallTime autostart_since_;
+  ros::WallTime last_autostart_warning_;
+  uint64_t raw_published_ = 0, raw_at_last_diag_ = 0, raw_batches_ = 0, capped_ticks_ = 0;
+  uint64_t slow_published_ = 0, sweep_published_ = 0, experiments_ = 0;
+  double lag_s_ = 0.0, max_lag_s_ = 0.0;
+  ros::WallTime last_diag_wall_;
   SlowRecord slow_, slow_truth_;
   SweepRecord sweep_;
   std::vector<bool> settled_;
-  size_t raw_next_ = 0, slow_next_ = 0, sweep_next_ = 0;
+  size_t slow_next_ = 0, sweep_next_ = 0;
   ros::Time start_stamp_;
   ros::WallTime wall_start_;
 };

@@ -38,6 +38,12 @@ struct SimulatorNodeOptions {
   int seed = 1;
   /// Multiplies the preset's noise standard deviations, >= 0 (0 = noise-free).
   double noise_scale = 1.0;
+  /// Longest free-decay record a start accepts [s], > 0 (memory: the raw record is produced
+  /// piece by piece, the slow records at the slow rate are held whole).
+  double max_duration_s = 600.0;
+  /// Most raw samples in one RawSampleBatch, >= 1000: when the node falls behind real time it
+  /// publishes at most this many per tick and reports the lag instead of sending huge messages.
+  int max_batch_samples = 50000;
   /// frame_id of the published headers.
   std::string frame_id = "resonator";
 

@@ -1,0 +1,165 @@
+#!/usr/bin/python3
+"""rostest: the simulated chain under load (realtime_factor 10 or 30, MEMS ring, raw at 300 kHz).
+Checks: the simulator publishes every raw sample of the record (when it cannot keep up it lags and
+says so, messages stay <= max_batch_samples); whatever the demodulator or identifier lose on the
+way is counted (identifier: received + dropped_in_transport = slow states the demodulator
+published; demodulator: a raw sample short implies a counted lost batch); each node's peak RSS
+(VmHWM) stays under RSS_LIMIT_MB; a normal run afterwards is identified within 5 % of the true
+gamma with no new loss (recovery). Measured figures are printed (and appended as a JSON line to
+$CVG_LOAD_REPORT when set)."""
+import json
+import math
+import os
+import threading
+import time
+import unittest
+import xmlrpc.client
+
+import rosgraph
+import rosnode
+import rospy
+import rostest
+
+from cvg_bench.msg import ModelEstimate, RawSampleBatch, SimulationTruth
+from cvg_bench.srv import StartFreeDecay
+from diagnostic_msgs.msg import DiagnosticArray
+
+RSS_LIMIT_MB = 250.0
+NODES = {"sim": "/cvg/resonator_simulator", "demod": "/cvg/demodulator",
+         "ident": "/cvg/identifier"}
+HW = {"sim": "cvg_bench resonator_simulator", "demod": "cvg_bench demodulator",
+      "ident": "cvg_bench identifier"}
+MAX_BATCH = 50000  # config/simulator.yaml max_batch_samples
+
+
+def peak_rss_mb(node):
+    uri = rosnode.get_api_uri(rosgraph.Master("/load_check"), node)
+    pid = xmlrpc.client.ServerProxy(uri).getPid("/load_check")[2]
+    with open("/proc/%d/status" % pid) as f:
+        for line in f:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024.0
+    raise RuntimeError("no VmHWM for " + node)
+
+
+class LoadCheck(unittest.TestCase):
+    def setUp(self):
+        self.lock = threading.Lock()
+        self.diag = {}
+        self.estimates = {}
+        self.truth = None
+        self.largest_batch = 0
+        self.raw_wall = []
+        rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diag)
+        rospy.Subscriber("/cvg/estimate", ModelEstimate, self.on_estimate)
+        rospy.Subscriber("/cvg/truth", SimulationTruth, self.on_truth)
+        rospy.Subscriber("/cvg/raw", RawSampleBatch, self.on_raw, queue_size=5)
+
+    def on_diag(self, msg):
+        with self.lock:
+            for st in msg.status:
+                for key, hw in HW.items():
+                    if st.hardware_id == hw:
+                        values = {kv.key: kv.value for kv in st.values}
+                        values["summary"] = st.message
+                        values["wall"] = time.monotonic()
+                        self.diag[key] = values
+
+    def on_estimate(self, msg):
+        with self.lock:
+            self.estimates[msg.experiment_id] = (msg, time.monotonic())
+
+    def on_truth(self, msg):
+        with self.lock:
+            self.truth = msg
+
+    def on_raw(self, msg):
+        with self.lock:
+            self.largest_batch = max(self.largest_batch, len(msg.f))
+            self.raw_wall.append(time.monotonic())
+
+    def wait(self, what, timeout_s, message):
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline and not rospy.is_shutdown():
+            with self.lock:
+                if what():
+                    return
+            time.sleep(0.05)  # poll period of the bounded wait
+        self.fail(message)
+
+    def final(self, experiment_id, after_wall):
+        """Diagnostics of all nodes and the estimate once the experiment is over and quiet."""
+        def done():
+            sim = self.diag.get("sim")
+            est = self.estimates.get(experiment_id)
+            return (sim is not None and sim["summary"] == "idle"
+                    and int(sim["experiments_started"]) == experiment_id and est is not None
+                    and float(self.diag["demod"]["input_rate_samples_per_s"]) == 0.0
+                    and float(self.diag["ident"]["input_rate_hz"]) == 0.0
+                    and time.monotonic() - est[1] > 2.0
+                    and all(d["wall"] > est[1] + 1.0 for d in self.diag.values()))
+        self.wait(done, 60.0, "experiment %d did not finish and settle" % experiment_id)
+        with self.lock:
+            return {k: dict(v) for k, v in self.diag.items()}, self.estimates[experiment_id][0]
+
+    def test_load(self):
+        factor = rospy.get_param("~realtime_factor")
+        duration_s = rospy.get_param("~duration_s")
+        rospy.wait_for_service("/cvg/start_free_decay", 10.0)
+        self.wait(lambda: len(self.diag) == 3, 10.0, "no diagnostics from all three nodes")
+        start = rospy.ServiceProxy("/cvg/start_free_decay", StartFreeDecay)
+        t0 = time.monotonic()
+        self.assertTrue(start(duration_s=duration_s, seed=3).success)
+        diag, _ = self.final(1, t0)
+        with self.lock:
+            raw_span = self.raw_wall[-1] - self.raw_wall[0] if len(self.raw_wall) > 1 else 0.0
+            largest = self.largest_batch
+        sim, demod, ident = diag["sim"], diag["demod"], diag["ident"]
+        n_record = math.floor(duration_s * 300000.0) + 1
+        self.assertEqual(int(sim["raw_samples_of_record"]), n_record)
+        self.assertEqual(int(sim["raw_samples_published"]), n_record, sim)
+        self.assertLessEqual(largest, MAX_BATCH)
+        # Every loss counted.
+        received_raw = int(demod["raw_samples_received"])
+        # Sequence gaps count every lost batch but the last ones (no later message shows the
+        # gap): what is missing beyond the counted batches is at most the final two batches.
+        lost = int(demod["batches_lost_in_transport"])
+        self.assertLessEqual(received_raw, n_record)
+        self.assertLessEqual(n_record - received_raw, (lost + 2) * MAX_BATCH)
+        tail_short = n_record - received_raw if lost == 0 else None
+        published_slow = int(demod["slow_states_published"])
+        self.assertEqual(int(ident["received"]) + int(ident["dropped_in_transport"]), published_slow)
+        rss = {k: peak_rss_mb(n) for k, n in NODES.items()}
+        for k, v in rss.items():
+            self.assertLess(v, RSS_LIMIT_MB, "%s peak RSS %.0f MB" % (k, v))
+        report = {
+            "realtime_factor": factor, "raw_samples": n_record,
+            "raw_publication_wall_s": round(raw_span, 3),
+            "sustained_raw_samples_per_s": round(n_record / raw_span) if raw_span > 0 else None,
+            "simulator_max_lag_s": float(sim["max_lag_s"]),
+            "ticks_capped": int(sim["ticks_capped_at_max_batch_samples"]),
+            "demod_batches_lost": lost,
+            "demod_raw_received": received_raw, "demod_uncounted_tail_samples": tail_short,
+            "slow_states_published": published_slow,
+            "ident_received": int(ident["received"]),
+            "ident_dropped_in_transport": int(ident["dropped_in_transport"]),
+            "peak_rss_mb": {k: round(v, 1) for k, v in rss.items()},
+        }
+        print("LOAD " + json.dumps(report))
+        if os.environ.get("CVG_LOAD_REPORT"):
+            with open(os.environ["CVG_LOAD_REPORT"], "a") as f:
+                f.write(json.dumps(report) + "\n")
+        # Recovery: a normal run, identified correctly, without new losses.
+        lost_before = int(ident["dropped_in_transport"])
+        t1 = time.monotonic()
+        self.assertTrue(start(duration_s=0.2, seed=4).success)
+        diag, est = self.final(2, t1)
+        self.assertEqual(int(diag["ident"]["dropped_in_transport"]), lost_before)
+        true_gamma = self.truth.values[list(self.truth.names).index("gamma")]
+        gamma = est.values[list(est.names).index("gamma")]
+        self.assertAlmostEqual(gamma, true_gamma, delta=0.05 * true_gamma)
+
+
+if __name__ == "__main__":
+    rospy.init_node("load_check")
+    rostest.rosrun("cvg_bench", "load_check", LoadCheck)
