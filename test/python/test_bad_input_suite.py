@@ -525,7 +525,7 @@ class BadInputSuite(unittest.TestCase):
                  os.path.join(outs, "e.json"), "--report", os.path.join(outs, "rep"),
                  "--no-figures"],
                 ["drift", "--params", self.base_json_path, "--json", os.path.join(outs, "d.json")],
-                ["demod", self.raw_path, "--out", os.path.join(outs, "s.csv")]]
+                ["demod", self.raw_path, "--rate", "2000", "--out", os.path.join(outs, "s.csv")]]
         for args in runs:
             p = subprocess.run([TOOL] + args, cwd=cwd, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, universal_newlines=True, timeout=120)
