@@ -43,6 +43,8 @@ double pairSnr(const SlowRecord& r, int c) {
   for (const auto& q : r.q) power += q[c] * q[c] + q[c + 1] * q[c + 1];
   power /= static_cast<double>(r.size());
   const double noise = noiseVariance(r, c) + noiseVariance(r, c + 1);
+  // Exact zeros (a noise-free standing wave) are no noise: exact rank reports the combinations.
+  if (power == 0.0) return INFINITY;
   if (!(power > 0.0)) return 0.0;
   if (!(noise > 0.0)) return INFINITY;
   return power / noise;
