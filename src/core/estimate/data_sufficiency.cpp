@@ -63,7 +63,8 @@ DataSufficiency assessFreeDecay(const SlowRecord& record, int n_params) {
   const size_t n = record.size();
   // (2.7): one block of 4 equations per interior sample.
   const long equations = n >= 2 ? 4 * static_cast<long>(n - 2) : 0;
-  if (equations < 2L * n_params) {
+  // Up to n_params equations the record is bad input (the regression's own check, exit 2).
+  if (equations > n_params && equations < 2L * n_params) {
     d.sufficient = false;
     d.reason = tooFew(n, "samples", equations, n_params);
     return d;
@@ -89,7 +90,7 @@ DataSufficiency assessSweep(const SweepRecord& record, int n_params) {
   DataSufficiency d;
   const size_t n = record.size();
   const long equations = 4 * static_cast<long>(n);  // (3.4): four equations per point
-  if (equations < 2L * n_params) {
+  if (equations > n_params && equations < 2L * n_params) {
     d.sufficient = false;
     d.reason = tooFew(n, "sweep points", equations, n_params);
     return d;
