@@ -43,6 +43,8 @@ double pairSnr(const SlowRecord& r, int c) {
   for (const auto& q : r.q) power += q[c] * q[c] + q[c + 1] * q[c + 1];
   power /= static_cast<double>(r.size());
   const double noise = noiseVariance(r, c) + noiseVariance(r, c + 1);
+  // Exact zeros (a noise-free standing wave) are no noise: exact rank reports the combinations.
+  if (power == 0.0) return INFINITY;
   if (!(power > 0.0)) return 0.0;
   if (!(noise > 0.0)) return INFINITY;
   return power / noise;
@@ -61,7 +63,8 @@ DataSufficiency assessFreeDecay(const SlowRecord& record, int n_params) {
   const size_t n = record.size();
   // (2.7): one block of 4 equations per interior sample.
   const long equations = n >= 2 ? 4 * static_cast<long>(n - 2) : 0;
-  if (equations < 2L * n_params) {
+  // Up to n_params equations the record is bad input (the regression's own check, exit 2).
+  if (equations > n_params && equations < 2L * n_params) {
     d.sufficient = false;
     d.reason = tooFew(n, "samples", equations, n_params);
     return d;
@@ -87,7 +90,7 @@ DataSufficiency assessSweep(const SweepRecord& record, int n_params) {
   DataSufficiency d;
   const size_t n = record.size();
   const long equations = 4 * static_cast<long>(n);  // (3.4): four equations per point
-  if (equations < 2L * n_params) {
+  if (equations > n_params && equations < 2L * n_params) {
     d.sufficient = false;
     d.reason = tooFew(n, "sweep points", equations, n_params);
     return d;

@@ -380,7 +380,11 @@ void writeFile(const Rec& record, const std::string& path, Writer writer) {
   requireOutputFile(path, "output record");
   std::ofstream out(path);
   if (!out) throw InputError(path + ": cannot open for writing");
-  writer(record, out);
+  try {
+    writer(record, out);
+  } catch (const InputError& e) {
+    throw InputError(path + ": " + e.what());
+  }
   out.close();
   if (!out) throw InputError(path + ": write failed");
 }

@@ -33,7 +33,7 @@ TEST(DemodulatorRecovery, HugeSampleIsDroppedAndTheFilterRestarts) {
   tone(o.omega_rad_s, t, f, g);
   f[8000] = 1e300;
   g[8001] = -1e300;
-  g[12000] = std::nan("");
+  g[17000] = std::nan("");
   Demodulator d(o);
   std::vector<SlowSample> out;
   // In batches, the corrupted one in the middle of a batch.
