@@ -1,0 +1,213 @@
+#include "cvg_bench/core/estimate/ringdown_segmentation.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "cvg_bench/core/model/errors.h"
+
+namespace cvg_bench {
+namespace {
+
+constexpr double kDbPerNeper = 20.0 / 2.302585092994046;  // 20 / ln 10
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return v[m];
+}
+
+/// Least-squares slope of y on t over the finite, non-skipped samples of [a, b).
+double slopeOver(const std::vector<double>& t, const std::vector<double>& y,
+                 const std::vector<bool>& skip, size_t a, size_t b) {
+  std::vector<double> tt, yy;
+  for (size_t i = a; i < b; ++i)
+    if (!skip[i] && std::isfinite(y[i])) tt.push_back(t[i]), yy.push_back(y[i]);
+  if (tt.size() < 3) return 0.0;
+  Eigen::MatrixXd X(tt.size(), 2);
+  Eigen::VectorXd Y(tt.size());
+  for (size_t i = 0; i < tt.size(); ++i) X(i, 0) = 1.0, X(i, 1) = tt[i] - tt.front(), Y(i) = yy[i];
+  return X.colPivHouseholderQr().solve(Y)(1);
+}
+
+}  // namespace
+
+std::vector<std::string> RingdownSegmentationOptions::validate() const {
+  std::vector<std::string> p;
+  if (!(floor_margin_db >= 3.0 && floor_margin_db <= 40.0))
+    p.push_back("floor_margin_db must be in [3, 40] dB");
+  if (!(dropout_depth_db > 0.0)) p.push_back("dropout_depth_db must be > 0 dB");
+  if (!(min_decay_db > 0.0)) p.push_back("min_decay_db must be > 0 dB");
+  return p;
+}
+
+std::vector<double> runningMedian(const std::vector<double>& y, const std::vector<bool>& skip,
+                                  int half) {
+  const int n = static_cast<int>(y.size());
+  std::vector<double> out(n, std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> w;
+  for (int i = 0; i < n; ++i) {
+    w.clear();
+    for (int j = std::max(0, i - half); j <= std::min(n - 1, i + half); ++j)
+      if (!skip[j] && std::isfinite(y[j])) w.push_back(y[j]);
+    if (!w.empty()) out[i] = median(w);
+  }
+  return out;
+}
+
+RingdownSegment segmentRingdown(const RingdownEnvelope& env,
+                                const RingdownSegmentationOptions& options) {
+  const auto problems = options.validate();
+  if (!problems.empty()) throw InputError("ring-down segmentation: " + problems.front());
+  const size_t n = env.size();
+  if (n < 8) throw InputError("ring-down envelope has " + std::to_string(n) + " samples (< 8)");
+  const auto& t = env.t_s;
+  const auto& y = env.log_amplitude;
+  RingdownSegment seg;
+  seg.dropout.assign(n, false);
+  for (size_t i = 0; i < n; ++i) seg.dropout[i] = !std::isfinite(y[i]);
+
+  // 1. Drop-outs against the running median (window 11), robust scale from differences.
+  {
+    const std::vector<double> med = runningMedian(y, seg.dropout, 5);
+    std::vector<double> d;
+    // Scale from the first half (plateau and early decay): the floor's log noise is far larger.
+    for (size_t i = 1; i < std::max<size_t>(n / 2, 8); ++i)
+      if (!seg.dropout[i] && !seg.dropout[i - 1]) d.push_back(std::fabs(y[i] - y[i - 1]));
+    seg.noise_sd_log = d.empty() ? 0.0 : 1.4826 * median(d) / std::sqrt(2.0);
+    const double depth = std::max(8.0 * seg.noise_sd_log, options.dropout_depth_db / kDbPerNeper);
+    for (size_t i = 0; i < n; ++i)
+      if (!seg.dropout[i] && std::isfinite(med[i]) && y[i] < med[i] - depth) seg.dropout[i] = true;
+  }
+  const int half = std::max(2, static_cast<int>(n / 100));
+  const std::vector<double> sm = runningMedian(y, seg.dropout, half);
+
+  // 3 (first pass). Hinge fit of the smoothed envelope on a subsampled grid (<= 1500 points).
+  const size_t stride = std::max<size_t>(1, n / 1500);
+  std::vector<size_t> idx;
+  for (size_t i = 0; i < n; i += stride)
+    if (std::isfinite(sm[i])) idx.push_back(i);
+  if (idx.size() < 8) throw AnalysisError("ring-down: fewer than 8 usable envelope samples");
+
+  // 2. Noise floor: last tenth flat compared with the overall decline.
+  const size_t tail_a = n - std::max<size_t>(4, n / 10);
+  const double tail_slope = slopeOver(t, y, seg.dropout, tail_a, n);
+  double peak_sm = -std::numeric_limits<double>::infinity();
+  size_t i_peak = 0;
+  for (size_t i : idx)
+    if (sm[i] > peak_sm) peak_sm = sm[i], i_peak = i;
+  const double overall_slope =
+      (sm[idx.back()] - peak_sm) / std::max(t[idx.back()] - t[i_peak], 1e-300);
+  // Floor: the tail is flat, and well below the peak (a plateau-only record is not a floor).
+  size_t i_end = n;
+  {
+    double pow_sum = 0.0;
+    size_t cnt = 0;
+    for (size_t i = tail_a; i < n; ++i)
+      if (!seg.dropout[i]) pow_sum += std::exp(2.0 * (y[i] - peak_sm)), ++cnt;
+    const double floor_log = cnt ? peak_sm + 0.5 * std::log(pow_sum / cnt) : peak_sm;
+    const bool flat = overall_slope < 0.0 && std::fabs(tail_slope) < 0.2 * std::fabs(overall_slope);
+    if (flat && peak_sm - floor_log > (options.floor_margin_db + options.min_decay_db) / kDbPerNeper) {
+      seg.has_floor = true;
+      seg.floor_log_amplitude = floor_log;
+      const double cut = floor_log + options.floor_margin_db / kDbPerNeper;
+      // The span ends at the first smoothed sample after the peak at or below the cut.
+      i_end = n;
+      for (size_t i = i_peak; i < n; ++i)
+        if (std::isfinite(sm[i]) && sm[i] <= cut) {
+          i_end = i;
+          break;
+        }
+      const double reach = floor_log + 3.0 / kDbPerNeper;
+      seg.floor_start_s = t.back();
+      for (size_t i = i_end; i < n; ++i)
+        if (std::isfinite(sm[i]) && sm[i] <= reach) {
+          seg.floor_start_s = t[i];
+          break;
+        }
+    }
+  }
+
+  // 3. Hinge on [0, i_end): y = c for t < t0, c - s (t - t0) after; grid of t0 up to the peak of
+  // the decline (candidates among the subsampled points before i_end).
+  std::vector<size_t> h;
+  for (size_t i : idx)
+    if (i < i_end) h.push_back(i);
+  if (h.size() < 8) throw AnalysisError("ring-down: no decay above the noise floor (" +
+                                        std::to_string(h.size()) + " envelope points)");
+  double best_sse = std::numeric_limits<double>::infinity();
+  size_t best_k = 0;
+  double best_c = sm[h[0]], best_s = 0.0;
+  const size_t n_cand = std::min<size_t>(h.size() / 2, 300);
+  const size_t cstep = std::max<size_t>(1, (h.size() / 2) / std::max<size_t>(n_cand, 1));
+  for (size_t k = 0; k < h.size() / 2; k += cstep) {
+    const double t0 = t[h[k]];
+    Eigen::MatrixXd X(h.size(), 2);
+    Eigen::VectorXd Y(h.size());
+    for (size_t j = 0; j < h.size(); ++j) {
+      X(j, 0) = 1.0;
+      X(j, 1) = std::min(0.0, -(t[h[j]] - t0));
+      Y(j) = sm[h[j]];
+    }
+    const Eigen::VectorXd b = X.colPivHouseholderQr().solve(Y);
+    const double sse = (Y - X * b).squaredNorm();
+    if (sse < best_sse && b(1) > 0.0) best_sse = sse, best_k = k, best_c = b(0), best_s = b(1);
+  }
+  const double dt = (t.back() - t.front()) / std::max<size_t>(1, n - 1);
+  // A plateau is flat: ln A before the hinge declines at under a tenth of the decay's rate
+  // (a slow-then-fast decay is not a plateau).
+  seg.has_plateau =
+      best_k >= 2 && std::fabs(slopeOver(t, sm, seg.dropout, 0, h[best_k])) < 0.1 * best_s;
+  if (!seg.has_plateau) best_k = 0, best_c = sm[h[0]];
+  seg.drive_off_s = t[h[best_k]];
+  seg.plateau_log_amplitude = best_c;
+  size_t i_start = seg.has_plateau ? h[best_k] : 0;
+  if (seg.has_plateau)
+    while (i_start < i_end && t[i_start] < seg.drive_off_s + 2.0 * dt) ++i_start;
+  seg.i_start = i_start;
+  seg.i_end = i_end;
+  for (size_t i = i_start; i < i_end; ++i) {
+    if (seg.dropout[i])
+      ++seg.n_dropouts_in_span;
+    else
+      ++seg.n_used;
+  }
+  // Decay over the span from the smoothed envelope.
+  double s_first = std::numeric_limits<double>::quiet_NaN(), s_last = s_first;
+  for (size_t i = i_start; i < i_end; ++i)
+    if (std::isfinite(sm[i])) {
+      if (!std::isfinite(s_first)) s_first = sm[i];
+      s_last = sm[i];
+    }
+  seg.decay_db = (s_first - s_last) * kDbPerNeper;
+  if (i_end > i_start) {
+    seg.t_start_s = t[i_start];
+    seg.t_end_s = t[i_end - 1];
+  }
+  std::ostringstream why;
+  why.precision(4);
+  const std::string unit = env.from_db ? " dB" : " dB re 1 unit";
+  if (seg.has_plateau)
+    why << "drive off at " << seg.drive_off_s << " s (plateau " << best_c * kDbPerNeper << unit
+        << ")";
+  else
+    why << "no plateau: decay from the first sample at " << t.front() << " s";
+  if (seg.has_floor)
+    why << "; floor " << seg.floor_log_amplitude * kDbPerNeper << unit << " from "
+        << seg.floor_start_s << " s, fit ends " << options.floor_margin_db
+        << " dB above it at " << seg.t_end_s << " s";
+  else
+    why << "; no noise floor reached (decay to the end, " << seg.t_end_s << " s)";
+  why << "; " << seg.n_dropouts_in_span << " drop-outs left out of " << (i_end - i_start)
+      << " samples; decay " << seg.decay_db << " dB";
+  seg.why = why.str();
+  if (seg.n_used < 8 || !(seg.decay_db >= std::max(options.min_decay_db,
+                                                   10.0 * seg.noise_sd_log * kDbPerNeper)))
+    throw AnalysisError("ring-down: no decay to fit (" + seg.why + ")");
+  return seg;
+}
+
+}  // namespace cvg_bench
