@@ -1,6 +1,7 @@
 #include "cvg_bench/core/estimate/ringdown_models.h"
 
 #include <cmath>
+#include <boost/math/special_functions/expint.hpp>
 #include <limits>
 
 #include "cvg_bench/core/model/errors.h"
@@ -60,8 +61,12 @@ double ringdownLogAmplitude(const std::string& model, const Eigen::VectorXd& p, 
     ringdownParameterNames(model);  // throws
   }
   if (!(floor_rel > 0.0)) return log_a;
-  const double m = std::max(log_a, std::log(floor_rel));
-  return m + 0.5 * std::log(std::exp(2.0 * (log_a - m)) + floor_rel * floor_rel * std::exp(-2.0 * m));
+  // Mean of ln|A + n| for circular Gaussian n of rms F (a Rice magnitude): ln A + E1(A^2/F^2) / 2
+  // (exact; below ~0.1 A^2/F^2 the floor dominates and the mean tends to ln F - 0.289).
+  const double x = std::exp(2.0 * log_a) / (floor_rel * floor_rel);
+  if (x > 40.0) return log_a;
+  if (x < 1e-8) return std::log(floor_rel) - 0.5 * 0.5772156649015329;
+  return log_a + 0.5 * boost::math::expint(1, x);
 }
 
 }  // namespace cvg_bench

@@ -78,9 +78,20 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     for (size_t i = 1; i < std::max<size_t>(n / 2, 8); ++i)
       if (!seg.dropout[i] && !seg.dropout[i - 1]) d.push_back(std::fabs(y[i] - y[i - 1]));
     seg.noise_sd_log = d.empty() ? 0.0 : 1.4826 * median(d) / std::sqrt(2.0);
-    const double depth = std::max(8.0 * seg.noise_sd_log, options.dropout_depth_db / kDbPerNeper);
+    // Depth: 3 dB, or 6 local robust sd (MAD about the running median over 21 samples), so that
+    // the Rice dips of additive noise near the floor are not taken for drop-outs.
+    const double depth0 = std::max(8.0 * seg.noise_sd_log, options.dropout_depth_db / kDbPerNeper);
+    std::vector<double> dev(n, 0.0);
     for (size_t i = 0; i < n; ++i)
-      if (!seg.dropout[i] && std::isfinite(med[i]) && y[i] < med[i] - depth) seg.dropout[i] = true;
+      dev[i] = std::isfinite(med[i]) && !seg.dropout[i] ? std::fabs(y[i] - med[i]) : 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      if (seg.dropout[i] || !std::isfinite(med[i])) continue;
+      std::vector<double> w;
+      for (size_t j = i >= 10 ? i - 10 : 0; j <= std::min(n - 1, i + 10); ++j)
+        if (!seg.dropout[j]) w.push_back(dev[j]);
+      const double local = 1.4826 * median(w);
+      if (y[i] < med[i] - std::max(depth0, 6.0 * local)) seg.dropout[i] = true;
+    }
   }
   const int half = std::max(2, static_cast<int>(n / 100));
   const std::vector<double> sm = runningMedian(y, seg.dropout, half);
@@ -166,7 +177,7 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
   seg.plateau_log_amplitude = best_c;
   size_t i_start = seg.has_plateau ? h[best_k] : 0;
   if (seg.has_plateau)
-    while (i_start < i_end && t[i_start] < seg.drive_off_s + 2.0 * dt) ++i_start;
+    while (i_start < i_end && t[i_start] < seg.drive_off_s + (half + 2) * dt) ++i_start;
   seg.i_start = i_start;
   seg.i_end = i_end;
   for (size_t i = i_start; i < i_end; ++i) {

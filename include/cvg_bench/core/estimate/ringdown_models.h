@@ -1,7 +1,8 @@
 // Envelope models of a single-channel ring-down, in normalized units: time t' = (t - t_start) / T
 // over the fitted span of length T, amplitude A' = A / A_ref (A_ref the span's first level), so the
-// fit is scale-free (an amplitude of 3e-4 and of 1 give the same answer). Each returns ln A'(t'),
-// with a known noise floor F' added in power: ln sqrt(A'^2 + F'^2) (additive noise of rms F').
+// fit is scale-free (an amplitude of 3e-4 and of 1 give the same answer). Each returns the mean of
+// ln A'(t') as detected over a known noise floor of rms F' (additive circular Gaussian noise, a Rice
+// magnitude): ln A' + E1(A'^2 / F'^2) / 2, which is ln A' to 4e-6 at 10 dB above the floor.
 // Damping conventions (amplitude decay rate g [1/T]; Q = omega tau / 2 = pi f T / g, tau = T / g
 // the amplitude time constant):
 //   linear     dA/dt = -g A                              ln A = a - g t
