@@ -39,7 +39,7 @@ double ringdownLogAmplitude(const std::string& model, const Eigen::VectorXd& p, 
   if (model == "linear") {
     log_a = p(0) - p(1) * t;
   } else if (model == "gamma_nl") {
-    const double den = 1.0 + p(2) * std::exp(2.0 * p(0)) * oneMinusExpOver(2.0 * p(1), t);
+    const double den = 1.0 + 2.0 * p(2) * std::exp(2.0 * p(0)) * oneMinusExpOver(2.0 * p(1), t);
     if (!(den > 0.0)) return nan;
     log_a = p(0) - p(1) * t - 0.5 * std::log(den);
   } else if (model == "gamma_a") {

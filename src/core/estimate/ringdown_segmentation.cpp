@@ -105,7 +105,7 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
 
   // 2. Noise floor: last tenth flat compared with the overall decline.
   const size_t tail_a = n - std::max<size_t>(4, n / 10);
-  const double tail_slope = slopeOver(t, y, seg.dropout, tail_a, n);
+  const double tail_slope = slopeOver(t, sm, seg.dropout, tail_a, n);  // smoothed: log-Rayleigh noise
   double peak_sm = -std::numeric_limits<double>::infinity();
   size_t i_peak = 0;
   for (size_t i : idx)
@@ -120,7 +120,7 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     for (size_t i = tail_a; i < n; ++i)
       if (!seg.dropout[i]) pow_sum += std::exp(2.0 * (y[i] - peak_sm)), ++cnt;
     const double floor_log = cnt ? peak_sm + 0.5 * std::log(pow_sum / cnt) : peak_sm;
-    const bool flat = overall_slope < 0.0 && std::fabs(tail_slope) < 0.2 * std::fabs(overall_slope);
+    const bool flat = overall_slope < 0.0 && std::fabs(tail_slope) < 0.25 * std::fabs(overall_slope);
     if (flat && peak_sm - floor_log > (options.floor_margin_db + options.min_decay_db) / kDbPerNeper) {
       seg.has_floor = true;
       seg.floor_log_amplitude = floor_log;
@@ -142,42 +142,31 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     }
   }
 
-  // 3. Hinge on [0, i_end): y = c for t < t0, c - s (t - t0) after; grid of t0 up to the peak of
-  // the decline (candidates among the subsampled points before i_end).
-  std::vector<size_t> h;
-  for (size_t i : idx)
-    if (i < i_end) h.push_back(i);
-  if (h.size() < 8) throw AnalysisError("ring-down: no decay above the noise floor (" +
-                                        std::to_string(h.size()) + " envelope points)");
-  double best_sse = std::numeric_limits<double>::infinity();
-  size_t best_k = 0;
-  double best_c = sm[h[0]], best_s = 0.0;
-  const size_t n_cand = std::min<size_t>(h.size() / 2, 300);
-  const size_t cstep = std::max<size_t>(1, (h.size() / 2) / std::max<size_t>(n_cand, 1));
-  for (size_t k = 0; k < h.size() / 2; k += cstep) {
-    const double t0 = t[h[k]];
-    Eigen::MatrixXd X(h.size(), 2);
-    Eigen::VectorXd Y(h.size());
-    for (size_t j = 0; j < h.size(); ++j) {
-      X(j, 0) = 1.0;
-      X(j, 1) = std::min(0.0, -(t[h[j]] - t0));
-      Y(j) = sm[h[j]];
+  // 3. Drive switch-off: the plateau level c0 is the median of the smoothed envelope over the first
+  // twentieth (a running median keeps the corner sharp); the decay starts where the envelope first
+  // falls delta = max(6 sd, 0.1 dB) below it. A plateau exists when that crossing comes later than
+  // three times the time the decay takes to fall by delta.
+  std::vector<double> head;
+  for (size_t i = 0; i < std::max<size_t>(5, n / 20) && i < n; ++i)
+    if (std::isfinite(sm[i])) head.push_back(sm[i]);
+  const double c0 = median(head);
+  const double delta = std::max(6.0 * seg.noise_sd_log, 0.1 / kDbPerNeper);
+  size_t i_cross = 0;
+  for (size_t i = 0; i < i_end; ++i)
+    if (std::isfinite(sm[i]) && sm[i] < c0 - delta) {
+      i_cross = i;
+      break;
     }
-    const Eigen::VectorXd b = X.colPivHouseholderQr().solve(Y);
-    const double sse = (Y - X * b).squaredNorm();
-    if (sse < best_sse && b(1) > 0.0) best_sse = sse, best_k = k, best_c = b(0), best_s = b(1);
-  }
-  const double dt = (t.back() - t.front()) / std::max<size_t>(1, n - 1);
-  // A plateau is flat: ln A before the hinge declines at under a tenth of the decay's rate
-  // (a slow-then-fast decay is not a plateau).
-  seg.has_plateau =
-      best_k >= 2 && std::fabs(slopeOver(t, sm, seg.dropout, 0, h[best_k])) < 0.1 * best_s;
-  if (!seg.has_plateau) best_k = 0, best_c = sm[h[0]];
-  seg.drive_off_s = t[h[best_k]];
-  seg.plateau_log_amplitude = best_c;
-  size_t i_start = seg.has_plateau ? h[best_k] : 0;
-  if (seg.has_plateau)
-    while (i_start < i_end && t[i_start] < seg.drive_off_s + (half + 2) * dt) ++i_start;
+  const size_t m_after = std::min(i_end, i_cross + std::max<size_t>(8, n / 20));
+  const double s_after = -slopeOver(t, sm, seg.dropout, i_cross, m_after);
+  seg.has_plateau = s_after > 0.0 && i_cross > 2 &&
+                    t[i_cross] - t.front() > 3.0 * delta / s_after;
+  seg.drive_off_s = seg.has_plateau ? t[i_cross] - delta / s_after : t.front();
+  seg.plateau_log_amplitude = c0;
+  const double best_c = c0;
+  size_t i_start = seg.has_plateau ? i_cross : 0;
+  if (i_end <= i_start + 8)
+    throw AnalysisError("ring-down: no decay above the noise floor");
   seg.i_start = i_start;
   seg.i_end = i_end;
   for (size_t i = i_start; i < i_end; ++i) {

@@ -8,7 +8,7 @@
 //   linear     dA/dt = -g A                              ln A = a - g t
 //   gamma_nl   dA/dt = -(g0 + g2 A^2) A  (gas, thermoelastic at large amplitude; the slow-variable
 //              form of the extension gamma_nl of docs/paper.md: -gamma_nl (f^2+g^2) f')
-//              A^2 = e^{2a} e^{-2 g0 t} / (1 + g2 e^{2a} (1 - e^{-2 g0 t}) / g0)
+//              A^2 = e^{2a} e^{-2 g0 t} / (1 + g2 e^{2a} (1 - e^{-2 g0 t}) / g0)  (1/A^2 is linear in e^{2 g0 t})
 //   gamma_a    dA/dt = -(g0 + g1 A) A    (clamping / friction-like loss)
 //              A = e^{a} e^{-g0 t} / (1 + g1 e^{a} (1 - e^{-g0 t}) / g0)
 //   beat       two close modes in one channel: A^2 = |e^{a1 - d1 t} + e^{a2 - d2 t} e^{i(w t + phi)}|^2
