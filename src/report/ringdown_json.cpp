@@ -6,10 +6,14 @@ namespace cvg_bench {
 namespace report {
 namespace {
 
-nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+nlohmann::json num(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
 
 nlohmann::json valueJson(const RingdownValue& v) {
-  nlohmann::json j = {{"value", num(v.value)}, {"std", num(v.std)}, {"ci_low", num(v.ci_low)},
+  nlohmann::json j = {{"value", num(v.value)},
+                      {"std", num(v.std)},
+                      {"ci_low", num(v.ci_low)},
                       {"ci_high", num(v.ci_high)}};
   if (v.crb_std > 0.0) j["crb_std"] = num(v.crb_std);
   return j;

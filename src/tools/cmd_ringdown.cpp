@@ -2,6 +2,8 @@
 // (interfaces.md, "Single-channel ring-downs"). Reader: core/io/ringdown_record.h; segmentation and
 // fit: core/estimate/ringdown_*.h; causes: core/diagnose/ringdown_causes.h; generator:
 // core/simulate/ringdown_simulator.h.
+#include <sys/stat.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -9,7 +11,6 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
-#include <sys/stat.h>
 
 #include "bag_input.h"
 #include "cli_args.h"
@@ -31,10 +32,12 @@ const char* kIdentifyHelp =
     "usage: cvg_ident identify INPUT --mode ringdown --model linear|TERMS [--frequency HZ]\n"
     "         [--confidence P] [--error-model auto|log|additive] [--floor-margin-db D]\n"
     "         [--q-bins N] [--json FILE]\n"
-    "Q of one channel's ring-down. INPUT: CSV with t and amplitude (linear) or power_db (dBm, dBV,\n"
+    "Q of one channel's ring-down. INPUT: CSV with t and amplitude (linear) or power_db (dBm, "
+    "dBV,\n"
     "any offset), '#'/'%' comment lines (frequency_hz: F, Frequency [Hz]: F or omega: W), ',' ';'\n"
     "or tab separated; or a raw waveform t,f (demodulated first); or a .bag of the project's\n"
-    "messages (channel 1 amplitude). The drive switch-off, the noise floor and drop-outs are found\n"
+    "messages (channel 1 amplitude). The drive switch-off, the noise floor and drop-outs are "
+    "found\n"
     "and only the decay above the floor is fitted (the output says which span and why).\n"
     "TERMS: linear, gamma_nl (damping + gamma_nl A^2), gamma_a (+ gamma_a A), beat (two close\n"
     "modes), two_stage. Q = omega tau / 2 = pi f tau (tau: amplitude time constant); the interval\n"
@@ -52,7 +55,8 @@ const char* kExplainHelp =
     "figures: envelope in dB with the model and span, residuals, Q against amplitude.\n";
 
 const char* kSimulateHelp =
-    "usage: cvg_ident simulate --mode ringdown --out FILE [--frequency HZ] [--q Q] [--amplitude A]\n"
+    "usage: cvg_ident simulate --mode ringdown --out FILE [--frequency HZ] [--q Q] [--amplitude "
+    "A]\n"
     "         [--scale linear|db] [--db-offset D] [--samples N] [--duration-s S] [--plateau-s S]\n"
     "         [--noise-db D] [--floor-db D] [--correlation RHO] [--dropouts N]\n"
     "         [--split-hz F --second-amplitude R [--q2 Q]] [--two-stage-ratio R [--q-fast Q]]\n"
@@ -95,8 +99,9 @@ RingdownEnvelope readEnvelope(const std::string& path, double frequency_hz,
   RingdownEnvelope env = ringdownEnvelope(rec, frequency_hz);
   for (const auto& n : env.notes) notes.push_back(n);
   if (!(env.frequency_hz > 0.0))
-    notes.push_back("no frequency (give --frequency HZ or a 'frequency_hz:' line): Q not computed, "
-                    "tau_s only");
+    notes.push_back(
+        "no frequency (give --frequency HZ or a 'frequency_hz:' line): Q not computed, "
+        "tau_s only");
   return env;
 }
 
@@ -118,15 +123,18 @@ void printFit(const RingdownFit& f, const RingdownSegment& seg, std::ostream& os
   os << "error model: " << f.error_model << " (" << f.error_model_why << ")\n";
   os << "n " << f.n << ", rms residual " << f.rms_log * kDbPerNeper << " dB, lag-1 correlation "
      << f.rho1 << "\n";
-  for (const auto& kv : f.parameters) os << "  " << std::setw(22) << std::left << kv.first << ci(kv.second) << "\n";
-  for (const auto& kv : f.derived) os << "  " << std::setw(22) << std::left << kv.first << ci(kv.second) << "\n";
+  for (const auto& kv : f.parameters)
+    os << "  " << std::setw(22) << std::left << kv.first << ci(kv.second) << "\n";
+  for (const auto& kv : f.derived)
+    os << "  " << std::setw(22) << std::left << kv.first << ci(kv.second) << "\n";
   os << "intervals: " << f.interval_method << "\n";
   if (!f.q_vs_amplitude.empty()) {
     os << "Q against amplitude (straight fit per bin):\n";
     for (const auto& b : f.q_vs_amplitude) {
       char buf[200];
-      std::snprintf(buf, sizeof(buf), "  level %8.2f dB  amplitude %-11.4g Q %-11.5g [%.5g, %.5g]\n",
-                    b.level_db, b.amplitude, b.Q.value, b.Q.ci_low, b.Q.ci_high);
+      std::snprintf(buf, sizeof(buf),
+                    "  level %8.2f dB  amplitude %-11.4g Q %-11.5g [%.5g, %.5g]\n", b.level_db,
+                    b.amplitude, b.Q.value, b.Q.ci_low, b.Q.ci_high);
       os << buf;
     }
   }
@@ -197,7 +205,8 @@ int runRingdownIdentify(const std::vector<std::string>& argv) {
   std::string model = model_arg;
   if (model.rfind("linear+", 0) == 0) model = model.substr(7);
   if (model.find('+') != std::string::npos)
-    throw InputError("--model: ring-down models take one extension at a time (got '" + model_arg + "')");
+    throw InputError("--model: ring-down models take one extension at a time (got '" + model_arg +
+                     "')");
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<std::string> notes;
   const RingdownEnvelope env =
@@ -207,8 +216,7 @@ int runRingdownIdentify(const std::vector<std::string>& argv) {
   const RingdownFitOptions fo = fitOptions(args);
   const RingdownSegment seg = segmentRingdown(env, so);
   const RingdownFit fit = fitRingdown(env, seg, model, fo);
-  const double secs =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::cout << std::setprecision(6);
   printFit(fit, seg, std::cout);
   for (const auto& n : notes) std::cout << "note: " << n << "\n";
@@ -242,11 +250,11 @@ int runRingdownExplain(const std::vector<std::string>& argv) {
   RingdownExplainOptions o;
   o.fit = fitOptions(args);
   o.alpha = args.getDouble("alpha", o.alpha);
-  o.segmentation.floor_margin_db = args.getDouble("floor-margin-db", o.segmentation.floor_margin_db);
+  o.segmentation.floor_margin_db =
+      args.getDouble("floor-margin-db", o.segmentation.floor_margin_db);
   if (args.has("candidates")) o.candidates = splitList(args.get("candidates"));
   const RingdownExplanation x = explainRingdown(env, o);
-  const double secs =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::cout << std::setprecision(6);
   std::cout << "baseline (single exponential): sigma " << x.baseline.sigma << ", rms "
             << x.baseline.rms_log * kDbPerNeper << " dB\n";
@@ -285,11 +293,17 @@ int runRingdownExplain(const std::vector<std::string>& argv) {
 }
 
 int runRingdownSimulate(const std::vector<std::string>& argv) {
-  const CliArgs args(argv,
-                     {"mode", "out", "frequency", "q", "amplitude", "scale", "db-offset",
-                      "samples", "duration-s", "plateau-s", "noise-db", "floor-db", "correlation",
-                      "dropouts", "split-hz", "second-amplitude", "q2", "two-stage-ratio",
-                      "q-fast", "detection-loss-db", "effect", "seed"},
+  const CliArgs args(argv, {"mode",        "out",
+                            "frequency",   "q",
+                            "amplitude",   "scale",
+                            "db-offset",   "samples",
+                            "duration-s",  "plateau-s",
+                            "noise-db",    "floor-db",
+                            "correlation", "dropouts",
+                            "split-hz",    "second-amplitude",
+                            "q2",          "two-stage-ratio",
+                            "q-fast",      "detection-loss-db",
+                            "effect",      "seed"},
                      {}, {"effect"});
   if (args.help()) {
     std::cout << kSimulateHelp;

@@ -1,9 +1,10 @@
 // Known-answer tests of the ring-down causes (ringdown_causes.h) on generated records.
+#include "cvg_bench/core/diagnose/ringdown_causes.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "cvg_bench/core/diagnose/ringdown_causes.h"
 #include "cvg_bench/core/simulate/ringdown_simulator.h"
 
 namespace cvg_bench {

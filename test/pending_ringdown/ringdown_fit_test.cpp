@@ -1,9 +1,10 @@
 // Known-answer tests of the ring-down segmentation and fit on records of the ring-down generator.
+#include "cvg_bench/core/estimate/ringdown_fit.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "cvg_bench/core/estimate/ringdown_fit.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/ringdown_simulator.h"
 

@@ -17,8 +17,10 @@ std::string rows(int n, const char* sep) {
 }
 
 TEST(RingdownReader, InstrumentHeaderWithUnitsAndPercentComments) {
-  const std::string text = "% Zero span export\n% Frequency [Hz]: 1.55e6\n% note: ring-down 3\n"
-                           "time [s]; power [dBm]\n" + rows(10, ";");
+  const std::string text =
+      "% Zero span export\n% Frequency [Hz]: 1.55e6\n% note: ring-down 3\n"
+      "time [s]; power [dBm]\n" +
+      rows(10, ";");
   const RingdownRecord r = readRingdownCsvText(text, "x.csv");
   EXPECT_EQ(r.kind, RingdownValueKind::kPowerDb);
   EXPECT_DOUBLE_EQ(r.frequency_hz, 1.55e6);
@@ -36,7 +38,8 @@ TEST(RingdownReader, HeaderOnlyInACommentAndOmegaKey) {
 
 TEST(RingdownReader, TabsRawWaveformAndNonFiniteDropOuts) {
   std::string text = "# frequency_hz: 50\nt\tf\n";
-  for (int i = 0; i < 9; ++i) text += std::to_string(i * 0.001) + "\t" + (i == 4 ? "nan" : "0.5") + "\n";
+  for (int i = 0; i < 9; ++i)
+    text += std::to_string(i * 0.001) + "\t" + (i == 4 ? "nan" : "0.5") + "\n";
   const RingdownRecord r = readRingdownCsvText(text, "w.csv");
   EXPECT_EQ(r.kind, RingdownValueKind::kRawWaveform);
   EXPECT_TRUE(std::isnan(r.value[4]));

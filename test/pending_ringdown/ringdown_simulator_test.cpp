@@ -1,9 +1,9 @@
 // The ring-down generator against closed forms (ringdown_models.h).
+#include "cvg_bench/core/simulate/ringdown_simulator.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "cvg_bench/core/simulate/ringdown_simulator.h"
 
 namespace cvg_bench {
 namespace {

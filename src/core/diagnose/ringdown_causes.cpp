@@ -74,8 +74,10 @@ double ringdownLackOfFitP(const RingdownFit& fit) {
       const double h = 1e-6 * (1.0 + std::fabs(fit.p(k)));
       Eigen::VectorXd pp = fit.p, pm = fit.p;
       pp(k) += h, pm(k) -= h;
-      X(i, k) = sw * (ringdownLogAmplitude(fit.model, pp, tn, fit.floor_rel) -
-                      ringdownLogAmplitude(fit.model, pm, tn, fit.floor_rel)) / (2 * h);
+      X(i, k) = sw *
+                (ringdownLogAmplitude(fit.model, pp, tn, fit.floor_rel) -
+                 ringdownLogAmplitude(fit.model, pm, tn, fit.floor_rel)) /
+                (2 * h);
     }
     const double x = 2.0 * tn - 1.0;  // Legendre P2..P5 on [-1, 1]
     const double P2 = 0.5 * (3 * x * x - 1), P3 = 0.5 * (5 * x * x * x - 3 * x);
@@ -112,8 +114,7 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     RingdownStep s;
     s.added = c;
     try {
-      fits.push_back(fitRingdown(env, x.segment, c, options.fit,
-                                 ringdownStarts(c, x.baseline)));
+      fits.push_back(fitRingdown(env, x.segment, c, options.fit, ringdownStarts(c, x.baseline)));
     } catch (const AnalysisError& e) {
       s.note = std::string("fit failed: ") + e.what();
       x.steps.push_back(s);
@@ -122,14 +123,15 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     }
     const RingdownFit& f = fits.back();
     // Variance inflation of the extended fit's residuals (HAC / iid), >= 1.
-    const double infl = std::max(1.0, f.cov_crb.trace() > 0
-                                          ? f.cov_hac.diagonal().cwiseQuotient(
-                                                f.cov_crb.diagonal().cwiseMax(1e-300)).mean()
-                                          : 1.0);
+    const double infl = std::max(
+        1.0, f.cov_crb.trace() > 0
+                 ? f.cov_hac.diagonal().cwiseQuotient(f.cov_crb.diagonal().cwiseMax(1e-300)).mean()
+                 : 1.0);
     s.n_eff = f.n / infl;
     s.sigma = f.sigma;
     s.sigma_ratio = x.baseline.sigma / std::max(f.sigma, 1e-300);
-    s.lr_statistic = s.n_eff * std::log(std::max(x.baseline.sse_w, 1e-300) / std::max(f.sse_w, 1e-300));
+    s.lr_statistic =
+        s.n_eff * std::log(std::max(x.baseline.sse_w, 1e-300) / std::max(f.sse_w, 1e-300));
     const int df = f.n_params - 2;
     double a = alpha_each;
     if (c == "beat") a /= std::max(1.0, f.n / 4.0);  // the split was searched over ~n/4 frequencies
@@ -139,8 +141,7 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     s.note = signCheck(f);
     s.physical = s.note.empty();
     s.accepted = s.significant && s.physical;
-    if (s.significant && !s.physical && (c == "gamma_nl" || c == "gamma_a") &&
-        f.p(2) < 0.0)
+    if (s.significant && !s.physical && (c == "gamma_nl" || c == "gamma_a") && f.p(2) < 0.0)
       negative_law = c;
     if (!s.significant && s.note.empty()) s.note = "not significant";
     x.steps.push_back(s);
@@ -168,7 +169,8 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
   auto qtext = [&](const std::string& k) {
     const auto it = fin.derived.find(k);
     if (it == fin.derived.end()) return std::string("n/a (no frequency)");
-    return fmt(it->second.value) + " [" + fmt(it->second.ci_low) + ", " + fmt(it->second.ci_high) + "]";
+    return fmt(it->second.value) + " [" + fmt(it->second.ci_low) + ", " + fmt(it->second.ci_high) +
+           "]";
   };
   if (x.segment.has_floor) {
     x.causes.push_back("noise_floor");

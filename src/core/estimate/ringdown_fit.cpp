@@ -158,7 +158,8 @@ std::vector<Eigen::VectorXd> ringdownStarts(const std::string& model, const Ring
     for (double frac : {0.0, 0.5, -0.3}) {
       Eigen::VectorXd p(3);
       // Split the rate at the start between g0 and the amplitude-dependent part.
-      p << a, g * (1.0 - frac), g * frac * (model == "gamma_nl" ? std::exp(-2.0 * a) : std::exp(-a));
+      p << a, g * (1.0 - frac),
+          g * frac * (model == "gamma_nl" ? std::exp(-2.0 * a) : std::exp(-a));
       s.push_back(p);
     }
   } else if (model == "two_stage") {
@@ -184,7 +185,8 @@ std::vector<Eigen::VectorXd> ringdownStarts(const std::string& model, const Ring
     const double dw = M_PI / 4.0;
     for (double w = 1.5 * 2 * M_PI; w < w_max; w += dw) {
       double c = 0, sn = 0;
-      for (int i = 0; i < n; ++i) c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
+      for (int i = 0; i < n; ++i)
+        c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
       const double pw = c * c + sn * sn;
       if (prev1 > prev2 && prev1 >= pw) peaks.emplace_back(prev1, w_prev);
       prev2 = prev1, prev1 = pw, w_prev = w;
@@ -194,7 +196,8 @@ std::vector<Eigen::VectorXd> ringdownStarts(const std::string& model, const Ring
     for (size_t k = 0; k < std::min<size_t>(3, peaks.size()); ++k) {
       const double w = peaks[k].second;
       double c = 0, sn = 0;
-      for (int i = 0; i < n; ++i) c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
+      for (int i = 0; i < n; ++i)
+        c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
       const double m = std::min(0.9, std::max(1e-3, 2.0 * std::sqrt(c * c + sn * sn) / n));
       const double phi = std::atan2(-sn, c);
       Eigen::VectorXd p(6);
@@ -435,17 +438,17 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
     const RingdownValue& main = model == "beat" ? d1 : d2;
     putQ("Q", main);
     fit.derived["tau_s"] = qFromRate(main, T);
-    fit.derived["amplitude_ratio"] = deltaValue(
-        [](const Eigen::VectorXd& q) { return std::exp(q(2) - q(0)); }, fit.p, fit.cov_hac,
-        fit.cov_crb, z);
+    fit.derived["amplitude_ratio"] =
+        deltaValue([](const Eigen::VectorXd& q) { return std::exp(q(2) - q(0)); }, fit.p,
+                   fit.cov_hac, fit.cov_crb, z);
     if (model == "beat") {
       fit.derived["frequency_split_hz"] = scaled(param(4), 1.0 / (2.0 * M_PI * T));
       fit.derived["frequency_split_rad_s"] = scaled(param(4), 1.0 / T);
       // Difference of the two modes' amplitude decay rates: the 2-D model's damping anisotropy
       // (docs/paper.md: modes along the damping axes decay at gamma +- anisotropy / 2).
-      fit.derived["damping_anisotropy_1_s"] = deltaValue(
-          [T](const Eigen::VectorXd& q) { return (q(1) - q(3)) / T; }, fit.p, fit.cov_hac,
-          fit.cov_crb, z);
+      fit.derived["damping_anisotropy_1_s"] =
+          deltaValue([T](const Eigen::VectorXd& q) { return (q(1) - q(3)) / T; }, fit.p,
+                     fit.cov_hac, fit.cov_crb, z);
     }
     if (d1.value < 0.0 || d2.value < 0.0) fit.flags.push_back("negative_damping");
   }

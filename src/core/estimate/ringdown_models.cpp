@@ -1,7 +1,7 @@
 #include "cvg_bench/core/estimate/ringdown_models.h"
 
-#include <cmath>
 #include <boost/math/special_functions/expint.hpp>
+#include <cmath>
 #include <limits>
 
 #include "cvg_bench/core/model/errors.h"

@@ -105,7 +105,8 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
 
   // 2. Noise floor: last tenth flat compared with the overall decline.
   const size_t tail_a = n - std::max<size_t>(4, n / 10);
-  const double tail_slope = slopeOver(t, sm, seg.dropout, tail_a, n);  // smoothed: log-Rayleigh noise
+  const double tail_slope =
+      slopeOver(t, sm, seg.dropout, tail_a, n);  // smoothed: log-Rayleigh noise
   double peak_sm = -std::numeric_limits<double>::infinity();
   size_t i_peak = 0;
   for (size_t i : idx)
@@ -120,8 +121,10 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     for (size_t i = tail_a; i < n; ++i)
       if (!seg.dropout[i]) pow_sum += std::exp(2.0 * (y[i] - peak_sm)), ++cnt;
     const double floor_log = cnt ? peak_sm + 0.5 * std::log(pow_sum / cnt) : peak_sm;
-    const bool flat = overall_slope < 0.0 && std::fabs(tail_slope) < 0.25 * std::fabs(overall_slope);
-    if (flat && peak_sm - floor_log > (options.floor_margin_db + options.min_decay_db) / kDbPerNeper) {
+    const bool flat =
+        overall_slope < 0.0 && std::fabs(tail_slope) < 0.25 * std::fabs(overall_slope);
+    if (flat &&
+        peak_sm - floor_log > (options.floor_margin_db + options.min_decay_db) / kDbPerNeper) {
       seg.has_floor = true;
       seg.floor_log_amplitude = floor_log;
       const double cut = floor_log + options.floor_margin_db / kDbPerNeper;
@@ -159,14 +162,12 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     }
   const size_t m_after = std::min(i_end, i_cross + std::max<size_t>(8, n / 20));
   const double s_after = -slopeOver(t, sm, seg.dropout, i_cross, m_after);
-  seg.has_plateau = s_after > 0.0 && i_cross > 2 &&
-                    t[i_cross] - t.front() > 3.0 * delta / s_after;
+  seg.has_plateau = s_after > 0.0 && i_cross > 2 && t[i_cross] - t.front() > 3.0 * delta / s_after;
   seg.drive_off_s = seg.has_plateau ? t[i_cross] - delta / s_after : t.front();
   seg.plateau_log_amplitude = c0;
   const double best_c = c0;
   size_t i_start = seg.has_plateau ? i_cross : 0;
-  if (i_end <= i_start + 8)
-    throw AnalysisError("ring-down: no decay above the noise floor");
+  if (i_end <= i_start + 8) throw AnalysisError("ring-down: no decay above the noise floor");
   seg.i_start = i_start;
   seg.i_end = i_end;
   for (size_t i = i_start; i < i_end; ++i) {
@@ -197,15 +198,15 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     why << "no plateau: decay from the first sample at " << t.front() << " s";
   if (seg.has_floor)
     why << "; floor " << seg.floor_log_amplitude * kDbPerNeper << unit << " from "
-        << seg.floor_start_s << " s, fit ends " << options.floor_margin_db
-        << " dB above it at " << seg.t_end_s << " s";
+        << seg.floor_start_s << " s, fit ends " << options.floor_margin_db << " dB above it at "
+        << seg.t_end_s << " s";
   else
     why << "; no noise floor reached (decay to the end, " << seg.t_end_s << " s)";
   why << "; " << seg.n_dropouts_in_span << " drop-outs left out of " << (i_end - i_start)
       << " samples; decay " << seg.decay_db << " dB";
   seg.why = why.str();
-  if (seg.n_used < 8 || !(seg.decay_db >= std::max(options.min_decay_db,
-                                                   10.0 * seg.noise_sd_log * kDbPerNeper)))
+  if (seg.n_used < 8 ||
+      !(seg.decay_db >= std::max(options.min_decay_db, 10.0 * seg.noise_sd_log * kDbPerNeper)))
     throw AnalysisError("ring-down: no decay to fit (" + seg.why + ")");
   return seg;
 }

@@ -65,8 +65,8 @@ HeaderCell parseHeaderCell(const std::string& cell) {
   const size_t open = c.find_first_of("[(");
   if (open != std::string::npos) {
     const size_t close = c.find_first_of("])", open);
-    h.unit = trim(c.substr(open + 1, close == std::string::npos ? std::string::npos
-                                                                 : close - open - 1));
+    h.unit =
+        trim(c.substr(open + 1, close == std::string::npos ? std::string::npos : close - open - 1));
   }
   return h;
 }
@@ -75,8 +75,10 @@ enum class ColumnRole { kNone, kTime, kAmplitude, kPowerDb, kRaw };
 
 ColumnRole roleOf(const HeaderCell& h) {
   const bool db_unit = h.unit.rfind("db", 0) == 0;
-  if (h.word == "t" || h.word == "time" || h.word == "t_s" || h.word == "time_s") return ColumnRole::kTime;
-  if (h.word == "power_db" || h.word.rfind("db", 0) == 0 || h.word == "level_db") return ColumnRole::kPowerDb;
+  if (h.word == "t" || h.word == "time" || h.word == "t_s" || h.word == "time_s")
+    return ColumnRole::kTime;
+  if (h.word == "power_db" || h.word.rfind("db", 0) == 0 || h.word == "level_db")
+    return ColumnRole::kPowerDb;
   if (h.word == "power" || h.word == "level" || h.word == "psd" || h.word == "spectrum")
     return db_unit ? ColumnRole::kPowerDb : ColumnRole::kNone;
   if (h.word == "amplitude" || h.word == "amp" || h.word == "r" || h.word == "mag" ||
@@ -104,9 +106,10 @@ HeaderChoice chooseColumns(const std::string& line) {
   for (size_t i = 0; i < cells.size(); ++i) {
     const ColumnRole r = roleOf(parseHeaderCell(cells[i]));
     if (r == ColumnRole::kTime && hc.time_col < 0) hc.time_col = static_cast<int>(i);
-    const int rank = r == ColumnRole::kAmplitude ? 0 : r == ColumnRole::kPowerDb ? 1
-                                                       : r == ColumnRole::kRaw    ? 2
-                                                                                  : 99;
+    const int rank = r == ColumnRole::kAmplitude ? 0
+                     : r == ColumnRole::kPowerDb ? 1
+                     : r == ColumnRole::kRaw     ? 2
+                                                 : 99;
     if (rank < best_rank) {
       best_rank = rank;
       hc.value_col = static_cast<int>(i);
@@ -161,7 +164,8 @@ RingdownRecord readRingdownCsvText(const std::string& text, const std::string& s
       if (parseKey(c, key, value)) {
         const HeaderCell kc = parseHeaderCell(key);
         double v = 0.0;
-        const bool is_freq = key == "frequency_hz" || (kc.word == "frequency" && (kc.unit == "hz" || kc.unit.empty())) ||
+        const bool is_freq = key == "frequency_hz" ||
+                             (kc.word == "frequency" && (kc.unit == "hz" || kc.unit.empty())) ||
                              key == "f0_hz" || key == "frequency";
         if ((is_freq || key == "omega" || kc.word == "omega") && !parseNumber(value, v))
           throw InputError(source_name + ":" + std::to_string(line_no) + ": key '" + key +
@@ -245,8 +249,8 @@ void writeRingdownCsv(const RingdownRecord& record, std::ostream& out) {
   for (const auto& c : record.comments)
     if (c.rfind("frequency_hz", 0) != 0) out << "# " << c << "\n";
   const char* name = record.kind == RingdownValueKind::kAmplitude ? "amplitude"
-                     : record.kind == RingdownValueKind::kPowerDb  ? "power_db"
-                                                                   : "f";
+                     : record.kind == RingdownValueKind::kPowerDb ? "power_db"
+                                                                  : "f";
   out << "t," << name << "\n";
   for (size_t i = 0; i < record.size(); ++i) out << record.t_s[i] << "," << record.value[i] << "\n";
 }

@@ -35,7 +35,8 @@ RingdownRecord simulateRingdown(const RingdownSimulationOptions& o) {
   }
   const double g0 = M_PI * o.frequency_hz / o.q;  // amplitude decay rate [1/s]
   const double tau = 1.0 / g0;
-  const double floor_amp = o.floor_db > -300.0 ? o.amplitude * std::pow(10.0, o.floor_db / 20.0) : 0.0;
+  const double floor_amp =
+      o.floor_db > -300.0 ? o.amplitude * std::pow(10.0, o.floor_db / 20.0) : 0.0;
   double duration = o.duration_s;
   if (!(duration > 0.0)) {
     const double decay = floor_amp > 0.0 ? tau * std::log(o.amplitude / floor_amp) : 8.0 * tau;
@@ -51,7 +52,8 @@ RingdownRecord simulateRingdown(const RingdownSimulationOptions& o) {
   const double rho = o.noise_correlation, innov = std::sqrt(1.0 - rho * rho);
   const double sd_m = o.noise_db / (20.0 / std::log(10.0));
   double em = sd_m * N01(rng);
-  std::complex<double> na(floor_amp / std::sqrt(2.0) * N01(rng), floor_amp / std::sqrt(2.0) * N01(rng));
+  std::complex<double> na(floor_amp / std::sqrt(2.0) * N01(rng),
+                          floor_amp / std::sqrt(2.0) * N01(rng));
   RingdownRecord rec;
   rec.frequency_hz = o.frequency_hz;
   rec.kind = o.output_db ? RingdownValueKind::kPowerDb : RingdownValueKind::kAmplitude;

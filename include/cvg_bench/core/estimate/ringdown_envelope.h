@@ -1,7 +1,7 @@
 // The log-amplitude envelope of a single-channel ring-down, whatever the file held: a linear
-// amplitude (ln A), a power in dB (ln A = P_dB ln(10) / 20: power ~ A^2, any dB offset is a constant
-// in ln A and drops out of Q), or a raw waveform f(t) demodulated first at the mode frequency
-// (demodulator.h with g = 0; A = sqrt(q1^2 + p1^2), the van der Pol amplitude of (2.4)).
+// amplitude (ln A), a power in dB (ln A = P_dB ln(10) / 20: power ~ A^2, any dB offset is a
+// constant in ln A and drops out of Q), or a raw waveform f(t) demodulated first at the mode
+// frequency (demodulator.h with g = 0; A = sqrt(q1^2 + p1^2), the van der Pol amplitude of (2.4)).
 #pragma once
 
 #include <string>

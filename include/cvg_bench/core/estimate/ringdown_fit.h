@@ -59,17 +59,17 @@ struct RingdownFit {
   double floor_rel = 0.0;                 ///< floor amplitude / A_ref in the model (0: none)
   double frequency_hz = 0.0;
   int n = 0, n_params = 0, rank = 0;
-  double sse_w = 0.0;   ///< weighted residual sum of squares
-  double sigma = 0.0;   ///< rms of the weighted residuals (1 = the error model's scale)
-  double rms_log = 0.0; ///< rms residual of ln A [Np]
-  double rho1 = 0.0;    ///< lag-1 autocorrelation of the residuals
+  double sse_w = 0.0;    ///< weighted residual sum of squares
+  double sigma = 0.0;    ///< rms of the weighted residuals (1 = the error model's scale)
+  double rms_log = 0.0;  ///< rms residual of ln A [Np]
+  double rho1 = 0.0;     ///< lag-1 autocorrelation of the residuals
   bool converged = false;
-  std::string error_model;       ///< "log" or "additive"
+  std::string error_model;  ///< "log" or "additive"
   std::string error_model_why;
   std::string interval_method;
   std::map<std::string, RingdownValue> parameters;  ///< physical: decay_rate_1_s, gamma_nl, ...
   std::map<std::string, RingdownValue> derived;     ///< Q, tau_s, Q0, frequency_split_hz, ...
-  std::vector<std::string> flags;  ///< e.g. "negative_damping"
+  std::vector<std::string> flags;                   ///< e.g. "negative_damping"
   std::vector<RingdownQBin> q_vs_amplitude;
   // Samples used, for reports: time, ln A, fitted ln A, weight.
   std::vector<double> t_s, log_amplitude, fitted, weight;

@@ -1,5 +1,5 @@
-// Segmentation of a single-channel ring-down into the driven plateau, the decay and the noise floor,
-// with drop-outs marked, so that only the decay above the floor is fitted.
+// Segmentation of a single-channel ring-down into the driven plateau, the decay and the noise
+// floor, with drop-outs marked, so that only the decay above the floor is fitted.
 //  1. Drop-outs: non-finite samples, and samples more than max(8 robust sd, 3 dB) below the running
 //     median of their neighbours (a detector that lost lock, a spectrum-analyser blank).
 //  2. Noise floor: the record's last tenth is flat (its slope is under a fifth of the decay's) ->
@@ -38,10 +38,10 @@ struct RingdownSegment {
   double floor_start_s = 0.0;        ///< where the envelope reaches the floor (when has_floor)
   std::vector<bool> dropout;         ///< per envelope sample
   size_t n_dropouts_in_span = 0;
-  size_t n_used = 0;                 ///< samples in the span that are not drop-outs
-  double decay_db = 0.0;             ///< drop of the running median over the span [dB]
-  double noise_sd_log = 0.0;         ///< robust sd of ln A from sample-to-sample differences
-  std::string why;                   ///< the printout/JSON sentence
+  size_t n_used = 0;          ///< samples in the span that are not drop-outs
+  double decay_db = 0.0;      ///< drop of the running median over the span [dB]
+  double noise_sd_log = 0.0;  ///< robust sd of ln A from sample-to-sample differences
+  std::string why;            ///< the printout/JSON sentence
 };
 
 /// Throws AnalysisError("no decay ...") when the record shows no usable decay, InputError when

@@ -18,26 +18,26 @@
 namespace cvg_bench {
 
 struct RingdownSimulationOptions {
-  double frequency_hz = 1.0e4;  ///< mode frequency [Hz], > 0
-  double q = 1.0e5;             ///< zero-amplitude Q of the mode, > 0
-  double amplitude = 1.0;       ///< amplitude at switch-off [any unit], > 0
-  double plateau_s = -1.0;      ///< plateau length [s]; < 0: 10 % of the record
-  double duration_s = 0.0;      ///< record length [s]; 0: plateau + decay to the floor + 30 %
-  int n_samples = 2000;         ///< samples in the record, >= 50
-  double gamma_nl = 0.0;        ///< A^2 damping [1/(s unit^2)]
-  double gamma_a = 0.0;         ///< A-linear damping [1/(s unit)]
-  double split_hz = 0.0;        ///< second close mode's offset [Hz] (0: none)
-  double second_amplitude = 0.0;  ///< its amplitude / the first's at switch-off
-  double q2 = 0.0;              ///< its Q (0: = q)
-  double two_stage_ratio = 0.0; ///< incoherent fast component / the mode at switch-off (0: none)
-  double q_fast = 0.0;          ///< its Q (0: q / 5)
-  double noise_db = 0.05;       ///< relative (log-scale) noise sd [dB], >= 0
-  double floor_db = -60.0;      ///< additive noise rms re the amplitude [dB] (<= -300: none)
+  double frequency_hz = 1.0e4;     ///< mode frequency [Hz], > 0
+  double q = 1.0e5;                ///< zero-amplitude Q of the mode, > 0
+  double amplitude = 1.0;          ///< amplitude at switch-off [any unit], > 0
+  double plateau_s = -1.0;         ///< plateau length [s]; < 0: 10 % of the record
+  double duration_s = 0.0;         ///< record length [s]; 0: plateau + decay to the floor + 30 %
+  int n_samples = 2000;            ///< samples in the record, >= 50
+  double gamma_nl = 0.0;           ///< A^2 damping [1/(s unit^2)]
+  double gamma_a = 0.0;            ///< A-linear damping [1/(s unit)]
+  double split_hz = 0.0;           ///< second close mode's offset [Hz] (0: none)
+  double second_amplitude = 0.0;   ///< its amplitude / the first's at switch-off
+  double q2 = 0.0;                 ///< its Q (0: = q)
+  double two_stage_ratio = 0.0;    ///< incoherent fast component / the mode at switch-off (0: none)
+  double q_fast = 0.0;             ///< its Q (0: q / 5)
+  double noise_db = 0.05;          ///< relative (log-scale) noise sd [dB], >= 0
+  double floor_db = -60.0;         ///< additive noise rms re the amplitude [dB] (<= -300: none)
   double noise_correlation = 0.0;  ///< AR(1) coefficient of both noises per sample, [0, 0.99]
-  int dropouts = 0;             ///< samples after switch-off blanked to -60 dB
+  int dropouts = 0;                ///< samples after switch-off blanked to -60 dB
   double detection_loss_db = 0.0;  ///< depth of the detection-gain step [dB], >= 0
-  bool output_db = false;       ///< write power_db (20 log10 A + db_offset) instead of amplitude
-  double db_offset = 0.0;       ///< dB offset (e.g. dBm re the unit)
+  bool output_db = false;          ///< write power_db (20 log10 A + db_offset) instead of amplitude
+  double db_offset = 0.0;          ///< dB offset (e.g. dBm re the unit)
   uint32_t seed = 1;
   std::vector<std::string> validate() const;
 };
