@@ -15,6 +15,10 @@ int runDemod(const std::vector<std::string>& args);
 int runIdentify(const std::vector<std::string>& args);
 int runDrift(const std::vector<std::string>& args);
 int runExplain(const std::vector<std::string>& args);
+// `--mode ringdown` of identify / explain / simulate (cmd_ringdown.cpp).
+int runRingdownIdentify(const std::vector<std::string>& args);
+int runRingdownExplain(const std::vector<std::string>& args);
+int runRingdownSimulate(const std::vector<std::string>& args);
 
 }  // namespace tools
 }  // namespace cvg_bench

@@ -18,6 +18,8 @@ const char* kUsage =
     "            [--confidence P] [--omega W] [--angular-gain K] [--json FILE]\n"
     "  drift     --params FILE.json [--r R --k K --theta TH | --theta-grid N] [--json FILE]\n"
     "  explain   INPUT --mode free_decay|forced [--json FILE] [--report DIR]\n"
+    "  identify|explain INPUT --mode ringdown [--frequency HZ] ...   single-channel ring-downs\n"
+    "  simulate  --mode ringdown --out FILE ...                      (see --mode ringdown --help)\n"
     "exit status: 0 success, 1 analysis failed, 2 bad usage or input\n";
 
 }  // namespace
@@ -43,7 +45,15 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    return it->second(std::vector<std::string>(argv + 2, argv + argc));
+    const std::vector<std::string> args(argv + 2, argv + argc);
+    // `--mode ringdown`: single-channel ring-downs (cmd_ringdown.cpp).
+    for (size_t i = 0; i + 1 < args.size(); ++i)
+      if ((args[i] == "--mode" && args[i + 1] == "ringdown") || args[i] == "--mode=ringdown") {
+        if (it->first == "identify") return runRingdownIdentify(args);
+        if (it->first == "explain") return runRingdownExplain(args);
+        if (it->first == "simulate") return runRingdownSimulate(args);
+      }
+    return it->second(args);
   } catch (const cvg_bench::InputError& e) {
     std::cerr << "cvg_ident " << argv[1] << ": error: " << e.what() << "\n";
     return 2;

@@ -1,0 +1,88 @@
+// Fit of a single-channel ring-down envelope over the segmented decay (ringdown_segmentation.h)
+// with the models of ringdown_models.h, in normalized units (scale-free), by weighted nonlinear
+// least squares on ln A (Levenberg-Marquardt, QR of the weighted Jacobian).
+//
+// Error model, chosen from the data: the sd of ln A, measured from sample-to-sample differences in
+// eight time bins of the span, is fitted as s^2 = s_m^2 + s_a^2 / A'^2. A constant s (s_m term)
+// is noise on the log/dB scale (relative noise); a growth as 1/A is additive noise on the amplitude
+// (with the floor). The weights are 1 / s^2 at each sample's fitted level either way.
+//
+// Intervals: HAC sandwich (hac_covariance.h: Newey-West, Bartlett weights, Andrews lag after VAR(1)
+// prewhitening) of the weighted residuals, which stays honest when the residuals are correlated
+// (detector filters, drift); the Cramer-Rao bound (white noise with the chosen error model:
+// sigma^2 (J'WJ)^-1) is reported beside it. Q = pi f tau (tau the amplitude time constant) with a
+// confidence interval mapped from that of the rate (asymmetric), std by the delta method.
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
+#include "cvg_bench/core/estimate/ringdown_segmentation.h"
+
+namespace cvg_bench {
+
+struct RingdownFitOptions {
+  /// Confidence level of the intervals, in (0, 1).
+  double confidence = 0.95;
+  /// "auto" (from the data), "log" or "additive".
+  std::string error_model = "auto";
+  /// Q against amplitude: number of amplitude bins (0 = automatic, 3 dB or more each, <= 8).
+  int q_bins = 0;
+  std::vector<std::string> validate() const;
+};
+
+/// A value with its standard error, interval, and the Cramer-Rao standard error (0 when none).
+struct RingdownValue {
+  double value = 0.0, std = 0.0, ci_low = 0.0, ci_high = 0.0, crb_std = 0.0;
+};
+
+/// Local Q over one amplitude bin (a straight ln A fit there, HAC interval).
+struct RingdownQBin {
+  double t_start_s = 0.0, t_end_s = 0.0;
+  double amplitude = 0.0;       ///< mean amplitude of the bin [file's unit]
+  double level_db = 0.0;        ///< 20 log10 of it (dB re the file's unit or dB offset)
+  double decay_rate_1_s = 0.0;  ///< local amplitude decay rate
+  RingdownValue Q;              ///< local Q (ci_high = +inf when the rate is not positive)
+  int n = 0;
+};
+
+struct RingdownFit {
+  std::string model;
+  std::vector<std::string> names;  ///< normalized parameter names (ringdown_models.h)
+  Eigen::VectorXd p;               ///< normalized parameters
+  Eigen::MatrixXd cov_hac, cov_crb;
+  double t_ref_s = 0.0, t_scale_s = 1.0;  ///< t' = (t - t_ref) / t_scale
+  double log_a_ref = 0.0;                 ///< ln A' = ln A - log_a_ref
+  double floor_rel = 0.0;                 ///< floor amplitude / A_ref in the model (0: none)
+  double frequency_hz = 0.0;
+  int n = 0, n_params = 0, rank = 0;
+  double sse_w = 0.0;    ///< weighted residual sum of squares
+  double sigma = 0.0;    ///< rms of the weighted residuals (1 = the error model's scale)
+  double rms_log = 0.0;  ///< rms residual of ln A [Np]
+  double rho1 = 0.0;     ///< lag-1 autocorrelation of the residuals
+  bool converged = false;
+  std::string error_model;  ///< "log" or "additive"
+  std::string error_model_why;
+  std::string interval_method;
+  std::map<std::string, RingdownValue> parameters;  ///< physical: decay_rate_1_s, gamma_nl, ...
+  std::map<std::string, RingdownValue> derived;     ///< Q, tau_s, Q0, frequency_split_hz, ...
+  std::vector<std::string> flags;                   ///< e.g. "negative_damping"
+  std::vector<RingdownQBin> q_vs_amplitude;
+  // Samples used, for reports: time, ln A, fitted ln A, weight.
+  std::vector<double> t_s, log_amplitude, fitted, weight;
+};
+
+/// Fits `model` over the segment. `starts` (normalized parameter vectors) replace the automatic
+/// starting points when given; the best converged one is kept. AnalysisError when no start
+/// converges to finite values.
+RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
+                        const std::string& model, const RingdownFitOptions& options = {},
+                        const std::vector<Eigen::VectorXd>& starts = {});
+
+/// Starting points for a model from a fitted linear baseline (residual periodogram for beat).
+std::vector<Eigen::VectorXd> ringdownStarts(const std::string& model, const RingdownFit& linear);
+
+}  // namespace cvg_bench

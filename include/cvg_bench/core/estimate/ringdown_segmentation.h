@@ -1,0 +1,56 @@
+// Segmentation of a single-channel ring-down into the driven plateau, the decay and the noise
+// floor, with drop-outs marked, so that only the decay above the floor is fitted.
+//  1. Drop-outs: non-finite samples, and samples more than max(8 robust sd, 3 dB) below the running
+//     median of their neighbours (a detector that lost lock, a spectrum-analyser blank).
+//  2. Noise floor: the record's last tenth is flat (its slope is under a fifth of the decay's) ->
+//     floor = rms amplitude of that tail; the decay span ends where the running median falls to
+//     `floor_margin_db` above the floor (the fit then includes the floor as an additive power).
+//  3. Drive switch-off: a hinge (constant, then a straight decline of ln A) fitted by QR on a grid
+//     of switch-off times; the span starts one median interval after the hinge.
+//  4. Refusal: under 3 dB (or 10 robust sd) of decay, or under 8 samples in the span.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
+
+namespace cvg_bench {
+
+struct RingdownSegmentationOptions {
+  /// Fit down to this far above the noise floor [dB], 3..40.
+  double floor_margin_db = 10.0;
+  /// A drop-out lies at least this far below its neighbours' median [dB] (and 8 robust sd).
+  double dropout_depth_db = 3.0;
+  /// Minimum decay in the span [dB] for a ring-down to be analysed.
+  double min_decay_db = 3.0;
+  std::vector<std::string> validate() const;
+};
+
+struct RingdownSegment {
+  size_t i_start = 0, i_end = 0;  ///< span [i_start, i_end) of envelope samples fitted
+  double t_start_s = 0.0, t_end_s = 0.0;
+  bool has_plateau = false;
+  double drive_off_s = 0.0;          ///< hinge time (= first sample time without a plateau)
+  double plateau_log_amplitude = 0;  ///< ln A of the plateau (or the start)
+  bool has_floor = false;
+  double floor_log_amplitude = 0.0;  ///< ln of the floor's rms amplitude (when has_floor)
+  double floor_start_s = 0.0;        ///< where the envelope reaches the floor (when has_floor)
+  std::vector<bool> dropout;         ///< per envelope sample
+  size_t n_dropouts_in_span = 0;
+  size_t n_used = 0;          ///< samples in the span that are not drop-outs
+  double decay_db = 0.0;      ///< drop of the running median over the span [dB]
+  double noise_sd_log = 0.0;  ///< robust sd of ln A from sample-to-sample differences
+  std::string why;            ///< the printout/JSON sentence
+};
+
+/// Throws AnalysisError("no decay ...") when the record shows no usable decay, InputError when
+/// the envelope is too short. db_units: say levels in dB re the file's unit (true for dB input).
+RingdownSegment segmentRingdown(const RingdownEnvelope& env,
+                                const RingdownSegmentationOptions& options = {});
+
+/// Running median of the finite values in a centred window of `half` samples each side.
+std::vector<double> runningMedian(const std::vector<double>& y, const std::vector<bool>& skip,
+                                  int half);
+
+}  // namespace cvg_bench

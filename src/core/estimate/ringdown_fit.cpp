@@ -1,0 +1,509 @@
+#include "cvg_bench/core/estimate/ringdown_fit.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <sstream>
+
+#include "cvg_bench/core/estimate/hac_covariance.h"
+#include "cvg_bench/core/estimate/ringdown_models.h"
+#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/model/errors.h"
+
+namespace cvg_bench {
+namespace {
+
+constexpr double kDbPerNeper = 20.0 / 2.302585092994046;
+const double kInf = std::numeric_limits<double>::infinity();
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return v[m];
+}
+
+struct Data {
+  Eigen::VectorXd t, y, w;  // normalized time, ln A', weights
+};
+
+/// Weighted residuals sqrt(w) (y - f(p)); false when the model is not finite somewhere.
+bool residuals(const std::string& model, const Eigen::VectorXd& p, const Data& d, double floor_rel,
+               Eigen::VectorXd& r) {
+  r.resize(d.t.size());
+  for (int i = 0; i < d.t.size(); ++i) {
+    const double f = ringdownLogAmplitude(model, p, d.t(i), floor_rel);
+    if (!std::isfinite(f)) return false;
+    r(i) = std::sqrt(d.w(i)) * (d.y(i) - f);
+  }
+  return true;
+}
+
+/// Jacobian of the weighted model sqrt(w) f(p) by central differences.
+bool jacobian(const std::string& model, const Eigen::VectorXd& p, const Data& d, double floor_rel,
+              Eigen::MatrixXd& J) {
+  J.resize(d.t.size(), p.size());
+  Eigen::VectorXd rp, rm;
+  for (int k = 0; k < p.size(); ++k) {
+    const double h = 1e-6 * (1.0 + std::fabs(p(k)));
+    Eigen::VectorXd pp = p, pm = p;
+    pp(k) += h;
+    pm(k) -= h;
+    if (!residuals(model, pp, d, floor_rel, rp) || !residuals(model, pm, d, floor_rel, rm))
+      return false;
+    J.col(k) = -(rp - rm) / (2.0 * h);  // d(sqrt(w) f)/dp
+  }
+  return true;
+}
+
+/// Levenberg-Marquardt on the weighted residuals, steps by QR of [J; sqrt(lambda) D].
+bool levenbergMarquardt(const std::string& model, Eigen::VectorXd& p, const Data& d,
+                        double floor_rel, double& sse) {
+  Eigen::VectorXd r;
+  if (!residuals(model, p, d, floor_rel, r)) return false;
+  sse = r.squaredNorm();
+  double lambda = 1e-3;
+  Eigen::MatrixXd J;
+  for (int it = 0; it < 200; ++it) {
+    if (!jacobian(model, p, d, floor_rel, J)) return false;
+    const Eigen::VectorXd dscale = J.colwise().norm().cwiseMax(1e-12);
+    bool improved = false;
+    for (int inner = 0; inner < 12 && !improved; ++inner) {
+      Eigen::MatrixXd A(J.rows() + p.size(), p.size());
+      Eigen::VectorXd b(J.rows() + p.size());
+      A.topRows(J.rows()) = J;
+      A.bottomRows(p.size()) = (std::sqrt(lambda) * dscale).asDiagonal();
+      b.head(J.rows()) = r;
+      b.tail(p.size()).setZero();
+      const Eigen::VectorXd step = A.colPivHouseholderQr().solve(b);
+      const Eigen::VectorXd pn = p + step;
+      Eigen::VectorXd rn;
+      if (residuals(model, pn, d, floor_rel, rn) && rn.squaredNorm() < sse) {
+        const double rel = (sse - rn.squaredNorm()) / std::max(sse, 1e-300);
+        p = pn;
+        r = rn;
+        sse = rn.squaredNorm();
+        lambda = std::max(lambda / 5.0, 1e-12);
+        improved = true;
+        if (rel < 1e-12 || step.norm() < 1e-12 * (1.0 + p.norm())) return true;
+      } else {
+        lambda *= 8.0;
+      }
+    }
+    if (!improved) return true;  // no decrease at any damping: a minimum
+  }
+  return true;
+}
+
+/// Standard error and interval of a function of the parameters by the delta method; `rate` gives
+/// the interval of a positive rate r, and value_of maps it (e.g. Q = c / r, decreasing).
+RingdownValue deltaValue(const std::function<double(const Eigen::VectorXd&)>& fn,
+                         const Eigen::VectorXd& p, const Eigen::MatrixXd& cov,
+                         const Eigen::MatrixXd& cov_crb, double z) {
+  RingdownValue v;
+  v.value = fn(p);
+  Eigen::VectorXd grad(p.size());
+  for (int k = 0; k < p.size(); ++k) {
+    const double h = 1e-6 * (1.0 + std::fabs(p(k)));
+    Eigen::VectorXd pp = p, pm = p;
+    pp(k) += h;
+    pm(k) -= h;
+    grad(k) = (fn(pp) - fn(pm)) / (2.0 * h);
+  }
+  v.std = std::sqrt(std::max(0.0, grad.dot(cov * grad)));
+  v.crb_std = std::sqrt(std::max(0.0, grad.dot(cov_crb * grad)));
+  v.ci_low = v.value - z * v.std;
+  v.ci_high = v.value + z * v.std;
+  return v;
+}
+
+/// Q = c / rate with the interval mapped from the rate's (a rate interval reaching 0 gives +inf).
+RingdownValue qFromRate(const RingdownValue& rate, double c) {
+  RingdownValue q;
+  q.value = c / rate.value;
+  q.std = c * rate.std / (rate.value * rate.value);
+  q.crb_std = c * rate.crb_std / (rate.value * rate.value);
+  q.ci_low = rate.ci_high > 0.0 ? c / rate.ci_high : kInf;
+  q.ci_high = rate.ci_low > 0.0 ? c / rate.ci_low : kInf;
+  if (rate.value <= 0.0) q.ci_low = -kInf, q.ci_high = kInf;
+  return q;
+}
+
+RingdownValue scaled(RingdownValue v, double s) {
+  v.value *= s, v.std *= std::fabs(s), v.crb_std *= std::fabs(s);
+  double lo = v.ci_low * s, hi = v.ci_high * s;
+  v.ci_low = std::min(lo, hi), v.ci_high = std::max(lo, hi);
+  return v;
+}
+
+}  // namespace
+
+std::vector<std::string> RingdownFitOptions::validate() const {
+  std::vector<std::string> p;
+  if (!(confidence > 0.0 && confidence < 1.0)) p.push_back("confidence must be in (0, 1)");
+  if (error_model != "auto" && error_model != "log" && error_model != "additive")
+    p.push_back("error_model must be auto, log or additive");
+  if (q_bins < 0 || q_bins > 20) p.push_back("q_bins must be in [0, 20]");
+  return p;
+}
+
+std::vector<Eigen::VectorXd> ringdownStarts(const std::string& model, const RingdownFit& lin) {
+  const double a = lin.p(0), g = std::max(lin.p(1), 0.05);
+  std::vector<Eigen::VectorXd> s;
+  if (model == "linear") {
+    s.push_back(lin.p);
+  } else if (model == "gamma_nl" || model == "gamma_a") {
+    for (double frac : {0.0, 0.5, -0.3}) {
+      Eigen::VectorXd p(3);
+      // Split the rate at the start between g0 and the amplitude-dependent part.
+      p << a, g * (1.0 - frac),
+          g * frac * (model == "gamma_nl" ? std::exp(-2.0 * a) : std::exp(-a));
+      s.push_back(p);
+    }
+  } else if (model == "two_stage") {
+    for (double ratio : {3.0, 10.0}) {
+      for (double lvl : {-1.0, -2.5}) {
+        Eigen::VectorXd p(4);
+        p << a, g * ratio, a + lvl, g * 0.7;
+        s.push_back(p);
+      }
+    }
+  } else if (model == "beat") {
+    // Residual periodogram of the linear fit: peaks between 1.5 cycles per span and a quarter of
+    // the sample rate give the split w; the modulation depth m gives A2/A1 ~ m.
+    const int n = static_cast<int>(lin.t_s.size());
+    std::vector<double> tt(n), rr(n);
+    for (int i = 0; i < n; ++i) {
+      tt[i] = (lin.t_s[i] - lin.t_ref_s) / lin.t_scale_s;
+      rr[i] = lin.log_amplitude[i] - lin.fitted[i];
+    }
+    const double w_max = M_PI * n / 2.0;
+    std::vector<std::pair<double, double>> peaks;  // power, w
+    double prev2 = 0, prev1 = 0, w_prev = 0;
+    const double dw = M_PI / 4.0;
+    for (double w = 1.5 * 2 * M_PI; w < w_max; w += dw) {
+      double c = 0, sn = 0;
+      for (int i = 0; i < n; ++i)
+        c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
+      const double pw = c * c + sn * sn;
+      if (prev1 > prev2 && prev1 >= pw) peaks.emplace_back(prev1, w_prev);
+      prev2 = prev1, prev1 = pw, w_prev = w;
+      if (peaks.size() > 400) break;
+    }
+    std::sort(peaks.rbegin(), peaks.rend());
+    for (size_t k = 0; k < std::min<size_t>(3, peaks.size()); ++k) {
+      const double w = peaks[k].second;
+      double c = 0, sn = 0;
+      for (int i = 0; i < n; ++i)
+        c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
+      const double m = std::min(0.9, std::max(1e-3, 2.0 * std::sqrt(c * c + sn * sn) / n));
+      const double phi = std::atan2(-sn, c);
+      Eigen::VectorXd p(6);
+      p << a, g, a + std::log(m), g, w, phi;
+      s.push_back(p);
+    }
+    if (s.empty()) {
+      Eigen::VectorXd p(6);
+      p << a, g, a - 2.0, g, 4.0 * M_PI, 0.0;
+      s.push_back(p);
+    }
+  } else {
+    ringdownParameterNames(model);  // throws for unknown names
+  }
+  return s;
+}
+
+RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
+                        const std::string& model, const RingdownFitOptions& options,
+                        const std::vector<Eigen::VectorXd>& starts) {
+  const auto problems = options.validate();
+  if (!problems.empty()) throw InputError("ring-down fit: " + problems.front());
+  RingdownFit fit;
+  fit.model = model;
+  fit.names = ringdownParameterNames(model);
+  fit.frequency_hz = env.frequency_hz;
+  std::vector<size_t> used;
+  for (size_t i = seg.i_start; i < seg.i_end; ++i)
+    if (!seg.dropout[i] && std::isfinite(env.log_amplitude[i])) used.push_back(i);
+  const int n = static_cast<int>(used.size());
+  if (n < static_cast<int>(fit.names.size()) + 4)
+    throw AnalysisError("ring-down: " + std::to_string(n) + " samples in the span for " +
+                        std::to_string(fit.names.size()) + " parameters of model " + model);
+  fit.t_ref_s = env.t_s[used.front()];
+  fit.t_scale_s = std::max(env.t_s[used.back()] - fit.t_ref_s, 1e-300);
+  {
+    std::vector<double> first;
+    for (int i = 0; i < std::min(n, 5); ++i) first.push_back(env.log_amplitude[used[i]]);
+    fit.log_a_ref = median(first);
+  }
+  fit.floor_rel = seg.has_floor ? std::exp(seg.floor_log_amplitude - fit.log_a_ref) : 0.0;
+  Data d;
+  d.t.resize(n), d.y.resize(n), d.w.resize(n);
+  for (int i = 0; i < n; ++i) {
+    d.t(i) = (env.t_s[used[i]] - fit.t_ref_s) / fit.t_scale_s;
+    d.y(i) = env.log_amplitude[used[i]] - fit.log_a_ref;
+  }
+
+  // Error model from differences in eight time bins: var = s_m^2 + s_a^2 exp(-2 level).
+  const int nb = std::max(2, std::min(8, n / 12));
+  std::vector<double> var_k, lvl_k;
+  for (int b = 0; b < nb; ++b) {
+    const int lo = b * n / nb, hi = (b + 1) * n / nb;
+    std::vector<double> dd, lv;
+    for (int i = lo + 1; i < hi; ++i) dd.push_back(std::fabs(d.y(i) - d.y(i - 1)));
+    for (int i = lo; i < hi; ++i) lv.push_back(d.y(i));
+    if (dd.size() < 3) continue;
+    const double s = 1.4826 * median(dd) / std::sqrt(2.0);
+    var_k.push_back(std::max(s * s, 1e-30));
+    lvl_k.push_back(median(lv));
+  }
+  double s_m2 = 0.0, s_a2 = 0.0;
+  if (var_k.size() >= 2) {
+    Eigen::MatrixXd X(var_k.size(), 2);
+    Eigen::VectorXd V(var_k.size());
+    for (size_t k = 0; k < var_k.size(); ++k)
+      X(k, 0) = 1.0, X(k, 1) = std::exp(-2.0 * lvl_k[k]), V(k) = var_k[k];
+    Eigen::VectorXd c = X.colPivHouseholderQr().solve(V);
+    if (c(0) < 0.0 || c(1) < 0.0) {  // non-negative: the better one-term fit
+      const double m_only = V.mean();
+      const double a_only = X.col(1).dot(V) / X.col(1).squaredNorm();
+      const double e_m = (V.array() - m_only).square().sum();
+      const double e_a = (V - a_only * X.col(1)).squaredNorm();
+      c << (e_m <= e_a ? m_only : 0.0), (e_m <= e_a ? 0.0 : a_only);
+    }
+    s_m2 = c(0), s_a2 = c(1);
+  } else if (!var_k.empty()) {
+    s_m2 = var_k.front();
+  }
+  const double lvl_low = lvl_k.empty() ? 0.0 : *std::min_element(lvl_k.begin(), lvl_k.end());
+  const double add_low = s_a2 * std::exp(-2.0 * lvl_low);
+  const bool additive = options.error_model == "additive" ||
+                        (options.error_model == "auto" && add_low > 1.0 * s_m2 &&
+                         var_k.size() >= 2 && var_k.back() > 2.0 * var_k.front());
+  {
+    std::ostringstream w;
+    w.precision(3);
+    const double sd_first = var_k.empty() ? 0.0 : std::sqrt(var_k.front()) * kDbPerNeper;
+    const double sd_last = var_k.empty() ? 0.0 : std::sqrt(var_k.back()) * kDbPerNeper;
+    w << (options.error_model == "auto" ? "chosen from the data: " : "forced by option: ")
+      << "sd of the level " << sd_first << " dB at the start, " << sd_last
+      << " dB at the end of the span -> "
+      << (additive ? "additive noise on the amplitude (sd grows as 1/A; floor in the model)"
+                   : "noise on the log/dB scale (sd constant)");
+    fit.error_model = additive ? "additive" : "log";
+    fit.error_model_why = w.str();
+  }
+  if (!additive) s_a2 = 0.0;
+  if (s_m2 <= 0.0 && s_a2 <= 0.0) s_m2 = 1.0;
+  // Weights at a smoothed level (5-point running mean), fixed during the fit.
+  for (int i = 0; i < n; ++i) {
+    double acc = 0;
+    int c = 0;
+    for (int j = std::max(0, i - 2); j <= std::min(n - 1, i + 2); ++j) acc += d.y(j), ++c;
+    const double lvl = acc / c;
+    d.w(i) = 1.0 / (s_m2 + s_a2 * std::exp(-2.0 * lvl));
+  }
+  // Normalize the weights to mean 1 (sigma then reads in units of the mean sd).
+  d.w /= d.w.mean();
+
+  // Starting points: the weighted straight line for linear, else given or derived from it.
+  std::vector<Eigen::VectorXd> st = starts;
+  if (st.empty()) {
+    Eigen::MatrixXd X(n, 2);
+    Eigen::VectorXd Y(n);
+    for (int i = 0; i < n; ++i) {
+      const double sw = std::sqrt(d.w(i));
+      X(i, 0) = sw, X(i, 1) = -sw * d.t(i), Y(i) = sw * d.y(i);
+    }
+    Eigen::VectorXd lin = X.colPivHouseholderQr().solve(Y);
+    if (model == "linear") {
+      st.push_back(lin);
+    } else {
+      RingdownFit base = fitRingdown(env, seg, "linear", options);
+      st = ringdownStarts(model, base);
+    }
+  }
+  double best = kInf;
+  for (auto p : st) {
+    double sse = kInf;
+    if (p.size() != static_cast<int>(fit.names.size())) continue;
+    if (!levenbergMarquardt(model, p, d, fit.floor_rel, sse)) continue;
+    if (sse < best) best = sse, fit.p = p;
+  }
+  if (!std::isfinite(best))
+    throw AnalysisError("ring-down: model " + model + " could not be fitted (no finite start)");
+  fit.converged = true;
+  // Canonical order for two-component models: component 1 is the faster (two_stage) / the
+  // larger at the start (beat).
+  if (model == "two_stage" && fit.p(1) < fit.p(3)) {
+    std::swap(fit.p(0), fit.p(2));
+    std::swap(fit.p(1), fit.p(3));
+  }
+  if (model == "beat") {
+    if (fit.p(2) > fit.p(0)) {
+      std::swap(fit.p(0), fit.p(2));
+      std::swap(fit.p(1), fit.p(3));
+      fit.p(4) = -fit.p(4), fit.p(5) = -fit.p(5);
+    }
+    if (fit.p(4) < 0.0) fit.p(4) = -fit.p(4), fit.p(5) = -fit.p(5);
+    fit.p(5) = std::remainder(fit.p(5), 2.0 * M_PI);
+  }
+  fit.sse_w = best;
+  Eigen::VectorXd r;
+  residuals(model, fit.p, d, fit.floor_rel, r);
+  Eigen::MatrixXd J;
+  jacobian(model, fit.p, d, fit.floor_rel, J);
+  const int p_n = static_cast<int>(fit.p.size());
+  fit.n = n;
+  fit.n_params = p_n;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J);
+  fit.rank = static_cast<int>(qr.rank());
+  fit.sigma = std::sqrt(best / std::max(1, n - p_n));
+  {
+    double s = 0, c0 = 0, c1 = 0;
+    for (int i = 0; i < n; ++i) {
+      const double e = r(i) / std::sqrt(d.w(i));
+      s += e * e;
+      c0 += r(i) * r(i);
+      if (i > 0) c1 += r(i) * r(i - 1);
+    }
+    fit.rms_log = std::sqrt(s / n);
+    fit.rho1 = c0 > 0 ? c1 / c0 : 0.0;
+  }
+  // CRB under white noise of the chosen model: sigma^2 (J'J)^-1 from R of the QR (pseudo-inverse).
+  {
+    const Eigen::MatrixXd Jp = J * qr.colsPermutation();
+    Eigen::HouseholderQR<Eigen::MatrixXd> hq(J);
+    Eigen::MatrixXd R = hq.matrixQR().topRows(p_n).triangularView<Eigen::Upper>();
+    Eigen::MatrixXd Rinv = Eigen::MatrixXd::Identity(p_n, p_n);
+    if (fit.rank == p_n)
+      Rinv = R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(p_n, p_n));
+    else
+      Rinv.setZero();
+    fit.cov_crb = fit.sigma * fit.sigma * Rinv * Rinv.transpose();
+    (void)Jp;
+  }
+  const HacCovariance hac = hacCovariance(J, r, -1);
+  fit.cov_hac = hac.covariance;
+  fit.interval_method = hac.method + " of the weighted ln A residuals (" + fit.error_model +
+                        " error model); Cramer-Rao bound for white noise reported beside it";
+  const double z = studentQuantile(options.confidence, std::max(1, n - p_n));
+
+  // Physical values. Time scale T: rates in 1/T -> 1/s divide by T.
+  const double T = fit.t_scale_s;
+  const double qc = M_PI * fit.frequency_hz * T;  // Q = qc / rate (rate in 1/T)
+  auto param = [&](int k) {
+    return deltaValue([k](const Eigen::VectorXd& q) { return q(k); }, fit.p, fit.cov_hac,
+                      fit.cov_crb, z);
+  };
+  auto putRate = [&](const std::string& name, const RingdownValue& rate) {
+    fit.parameters[name] = scaled(rate, 1.0 / T);
+  };
+  auto putQ = [&](const std::string& name, const RingdownValue& rate) {
+    if (fit.frequency_hz > 0.0) fit.derived[name] = qFromRate(rate, qc);
+  };
+  const double a_ref = std::exp(fit.log_a_ref);
+  if (model == "linear") {
+    const RingdownValue g = param(1);
+    putRate("decay_rate_1_s", g);
+    putQ("Q", g);
+    RingdownValue tau = qFromRate(g, T);
+    fit.derived["tau_s"] = tau;
+    if (g.value < 0.0) fit.flags.push_back("negative_damping");
+  } else if (model == "gamma_nl" || model == "gamma_a") {
+    const bool sq = model == "gamma_nl";
+    const RingdownValue g0 = param(1);
+    const RingdownValue gn = param(2);
+    putRate("decay_rate_1_s", g0);
+    // Physical coefficient: rate = g0 + gamma_nl A^2 (A in the file's unit), or + gamma_a A.
+    fit.parameters[model] = scaled(gn, 1.0 / (T * (sq ? a_ref * a_ref : a_ref)));
+    putQ("Q0", g0);
+    const RingdownValue start_rate = deltaValue(
+        [sq](const Eigen::VectorXd& q) { return q(1) + q(2) * std::exp((sq ? 2.0 : 1.0) * q(0)); },
+        fit.p, fit.cov_hac, fit.cov_crb, z);
+    putQ("Q", start_rate);
+    fit.derived["tau_s"] = qFromRate(start_rate, T);
+    if (g0.value < 0.0 || start_rate.value < 0.0) fit.flags.push_back("negative_damping");
+    if (gn.value < 0.0) fit.flags.push_back("negative_amplitude_dependent_damping");
+  } else if (model == "beat" || model == "two_stage") {
+    const RingdownValue d1 = param(1), d2 = param(3);
+    putRate("decay_rate_1_1_s", d1);
+    putRate("decay_rate_2_1_s", d2);
+    putQ("Q_mode1", d1);
+    putQ("Q_mode2", d2);
+    // Q: the mode that dominates the span (beat: larger at the start; two_stage: the slow,
+    // late stage).
+    const RingdownValue& main = model == "beat" ? d1 : d2;
+    putQ("Q", main);
+    fit.derived["tau_s"] = qFromRate(main, T);
+    fit.derived["amplitude_ratio"] =
+        deltaValue([](const Eigen::VectorXd& q) { return std::exp(q(2) - q(0)); }, fit.p,
+                   fit.cov_hac, fit.cov_crb, z);
+    if (model == "beat") {
+      fit.derived["frequency_split_hz"] = scaled(param(4), 1.0 / (2.0 * M_PI * T));
+      fit.derived["frequency_split_rad_s"] = scaled(param(4), 1.0 / T);
+      // Difference of the two modes' amplitude decay rates: the 2-D model's damping anisotropy
+      // (docs/paper.md: modes along the damping axes decay at gamma +- anisotropy / 2).
+      fit.derived["damping_anisotropy_1_s"] =
+          deltaValue([T](const Eigen::VectorXd& q) { return (q(1) - q(3)) / T; }, fit.p,
+                     fit.cov_hac, fit.cov_crb, z);
+    }
+    if (d1.value < 0.0 || d2.value < 0.0) fit.flags.push_back("negative_damping");
+  }
+
+  // Samples for reports.
+  for (int i = 0; i < n; ++i) {
+    fit.t_s.push_back(env.t_s[used[i]]);
+    fit.log_amplitude.push_back(env.log_amplitude[used[i]]);
+    fit.fitted.push_back(ringdownLogAmplitude(model, fit.p, d.t(i), fit.floor_rel) + fit.log_a_ref);
+    fit.weight.push_back(d.w(i));
+  }
+
+  // Q against amplitude: straight ln A fits over bins of equal fitted-level drop.
+  const double drop_db = (fit.fitted.front() - fit.fitted.back()) * kDbPerNeper;
+  int bins = options.q_bins > 0 ? options.q_bins
+                                : static_cast<int>(std::min(8.0, std::floor(drop_db / 3.0)));
+  bins = std::min(bins, n / 12);
+  if (bins >= 2 && fit.frequency_hz > 0.0) {
+    const double l0 = fit.fitted.front(), l1 = fit.fitted.back();
+    int i = 0;
+    for (int b = 0; b < bins; ++b) {
+      const double edge = l0 + (l1 - l0) * (b + 1) / bins;
+      std::vector<int> idx;
+      while (i < n && (b == bins - 1 || fit.fitted[i] >= edge)) idx.push_back(i++);
+      const int m = static_cast<int>(idx.size());
+      if (m < 10) continue;
+      Eigen::MatrixXd X(m, 2);
+      Eigen::VectorXd Y(m);
+      const double tb = d.t(idx.front()), ts = std::max(d.t(idx.back()) - tb, 1e-12);
+      double lvl = 0;
+      for (int k = 0; k < m; ++k) {
+        const double sw = std::sqrt(d.w(idx[k]));
+        X(k, 0) = sw, X(k, 1) = -sw * (d.t(idx[k]) - tb) / ts, Y(k) = sw * d.y(idx[k]);
+        lvl += fit.fitted[idx[k]];
+      }
+      lvl /= m;
+      const Eigen::VectorXd c = X.colPivHouseholderQr().solve(Y);
+      const Eigen::VectorXd res = Y - X * c;
+      const HacCovariance hb = hacCovariance(X, res, -1);
+      RingdownValue rate;
+      const double zb = studentQuantile(options.confidence, std::max(1, m - 2));
+      rate.value = c(1) / ts;  // in 1/T
+      rate.std = std::sqrt(std::max(0.0, hb.covariance(1, 1))) / ts;
+      rate.ci_low = rate.value - zb * rate.std, rate.ci_high = rate.value + zb * rate.std;
+      RingdownQBin qb;
+      qb.n = m;
+      qb.t_start_s = fit.t_s[idx.front()], qb.t_end_s = fit.t_s[idx.back()];
+      qb.amplitude = std::exp(lvl);
+      qb.level_db = lvl * kDbPerNeper;
+      qb.decay_rate_1_s = rate.value / T;
+      qb.Q = qFromRate(rate, qc);
+      fit.q_vs_amplitude.push_back(qb);
+    }
+  }
+  return fit;
+}
+
+}  // namespace cvg_bench

@@ -1,0 +1,214 @@
+#include "cvg_bench/core/estimate/ringdown_segmentation.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "cvg_bench/core/model/errors.h"
+
+namespace cvg_bench {
+namespace {
+
+constexpr double kDbPerNeper = 20.0 / 2.302585092994046;  // 20 / ln 10
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return v[m];
+}
+
+/// Least-squares slope of y on t over the finite, non-skipped samples of [a, b).
+double slopeOver(const std::vector<double>& t, const std::vector<double>& y,
+                 const std::vector<bool>& skip, size_t a, size_t b) {
+  std::vector<double> tt, yy;
+  for (size_t i = a; i < b; ++i)
+    if (!skip[i] && std::isfinite(y[i])) tt.push_back(t[i]), yy.push_back(y[i]);
+  if (tt.size() < 3) return 0.0;
+  Eigen::MatrixXd X(tt.size(), 2);
+  Eigen::VectorXd Y(tt.size());
+  for (size_t i = 0; i < tt.size(); ++i) X(i, 0) = 1.0, X(i, 1) = tt[i] - tt.front(), Y(i) = yy[i];
+  return X.colPivHouseholderQr().solve(Y)(1);
+}
+
+}  // namespace
+
+std::vector<std::string> RingdownSegmentationOptions::validate() const {
+  std::vector<std::string> p;
+  if (!(floor_margin_db >= 3.0 && floor_margin_db <= 40.0))
+    p.push_back("floor_margin_db must be in [3, 40] dB");
+  if (!(dropout_depth_db > 0.0)) p.push_back("dropout_depth_db must be > 0 dB");
+  if (!(min_decay_db > 0.0)) p.push_back("min_decay_db must be > 0 dB");
+  return p;
+}
+
+std::vector<double> runningMedian(const std::vector<double>& y, const std::vector<bool>& skip,
+                                  int half) {
+  const int n = static_cast<int>(y.size());
+  std::vector<double> out(n, std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> w;
+  for (int i = 0; i < n; ++i) {
+    w.clear();
+    for (int j = std::max(0, i - half); j <= std::min(n - 1, i + half); ++j)
+      if (!skip[j] && std::isfinite(y[j])) w.push_back(y[j]);
+    if (!w.empty()) out[i] = median(w);
+  }
+  return out;
+}
+
+RingdownSegment segmentRingdown(const RingdownEnvelope& env,
+                                const RingdownSegmentationOptions& options) {
+  const auto problems = options.validate();
+  if (!problems.empty()) throw InputError("ring-down segmentation: " + problems.front());
+  const size_t n = env.size();
+  if (n < 8) throw InputError("ring-down envelope has " + std::to_string(n) + " samples (< 8)");
+  const auto& t = env.t_s;
+  const auto& y = env.log_amplitude;
+  RingdownSegment seg;
+  seg.dropout.assign(n, false);
+  for (size_t i = 0; i < n; ++i) seg.dropout[i] = !std::isfinite(y[i]);
+
+  // 1. Drop-outs against the running median (window 11), robust scale from differences.
+  {
+    const std::vector<double> med = runningMedian(y, seg.dropout, 5);
+    std::vector<double> d;
+    // Scale from the first half (plateau and early decay): the floor's log noise is far larger.
+    for (size_t i = 1; i < std::max<size_t>(n / 2, 8); ++i)
+      if (!seg.dropout[i] && !seg.dropout[i - 1]) d.push_back(std::fabs(y[i] - y[i - 1]));
+    seg.noise_sd_log = d.empty() ? 0.0 : 1.4826 * median(d) / std::sqrt(2.0);
+    // Depth: 3 dB, or 6 local robust sd (MAD about the running median over 21 samples), so that
+    // the Rice dips of additive noise near the floor are not taken for drop-outs.
+    const double depth0 = std::max(8.0 * seg.noise_sd_log, options.dropout_depth_db / kDbPerNeper);
+    std::vector<double> dev(n, 0.0);
+    for (size_t i = 0; i < n; ++i)
+      dev[i] = std::isfinite(med[i]) && !seg.dropout[i] ? std::fabs(y[i] - med[i]) : 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      if (seg.dropout[i] || !std::isfinite(med[i])) continue;
+      std::vector<double> w;
+      for (size_t j = i >= 10 ? i - 10 : 0; j <= std::min(n - 1, i + 10); ++j)
+        if (!seg.dropout[j]) w.push_back(dev[j]);
+      const double local = 1.4826 * median(w);
+      if (y[i] < med[i] - std::max(depth0, 6.0 * local)) seg.dropout[i] = true;
+    }
+  }
+  const int half = std::max(2, static_cast<int>(n / 100));
+  const std::vector<double> sm = runningMedian(y, seg.dropout, half);
+
+  // 3 (first pass). Hinge fit of the smoothed envelope on a subsampled grid (<= 1500 points).
+  const size_t stride = std::max<size_t>(1, n / 1500);
+  std::vector<size_t> idx;
+  for (size_t i = 0; i < n; i += stride)
+    if (std::isfinite(sm[i])) idx.push_back(i);
+  if (idx.size() < 8) throw AnalysisError("ring-down: fewer than 8 usable envelope samples");
+
+  // 2. Noise floor: last tenth flat compared with the overall decline.
+  const size_t tail_a = n - std::max<size_t>(4, n / 10);
+  const double tail_slope =
+      slopeOver(t, sm, seg.dropout, tail_a, n);  // smoothed: log-Rayleigh noise
+  double peak_sm = -std::numeric_limits<double>::infinity();
+  size_t i_peak = 0;
+  for (size_t i : idx)
+    if (sm[i] > peak_sm) peak_sm = sm[i], i_peak = i;
+  const double overall_slope =
+      (sm[idx.back()] - peak_sm) / std::max(t[idx.back()] - t[i_peak], 1e-300);
+  // Floor: the tail is flat, and well below the peak (a plateau-only record is not a floor).
+  size_t i_end = n;
+  {
+    double pow_sum = 0.0;
+    size_t cnt = 0;
+    for (size_t i = tail_a; i < n; ++i)
+      if (!seg.dropout[i]) pow_sum += std::exp(2.0 * (y[i] - peak_sm)), ++cnt;
+    const double floor_log = cnt ? peak_sm + 0.5 * std::log(pow_sum / cnt) : peak_sm;
+    const bool flat =
+        overall_slope < 0.0 && std::fabs(tail_slope) < 0.25 * std::fabs(overall_slope);
+    if (flat &&
+        peak_sm - floor_log > (options.floor_margin_db + options.min_decay_db) / kDbPerNeper) {
+      seg.has_floor = true;
+      seg.floor_log_amplitude = floor_log;
+      const double cut = floor_log + options.floor_margin_db / kDbPerNeper;
+      // The span ends at the first smoothed sample after the peak at or below the cut.
+      i_end = n;
+      for (size_t i = i_peak; i < n; ++i)
+        if (std::isfinite(sm[i]) && sm[i] <= cut) {
+          i_end = i;
+          break;
+        }
+      const double reach = floor_log + 3.0 / kDbPerNeper;
+      seg.floor_start_s = t.back();
+      for (size_t i = i_end; i < n; ++i)
+        if (std::isfinite(sm[i]) && sm[i] <= reach) {
+          seg.floor_start_s = t[i];
+          break;
+        }
+    }
+  }
+
+  // 3. Drive switch-off: the plateau level c0 is the median of the smoothed envelope over the first
+  // twentieth (a running median keeps the corner sharp); the decay starts where the envelope first
+  // falls delta = max(6 sd, 0.1 dB) below it. A plateau exists when that crossing comes later than
+  // three times the time the decay takes to fall by delta.
+  std::vector<double> head;
+  for (size_t i = 0; i < std::max<size_t>(5, n / 20) && i < n; ++i)
+    if (std::isfinite(sm[i])) head.push_back(sm[i]);
+  const double c0 = median(head);
+  const double delta = std::max(6.0 * seg.noise_sd_log, 0.1 / kDbPerNeper);
+  size_t i_cross = 0;
+  for (size_t i = 0; i < i_end; ++i)
+    if (std::isfinite(sm[i]) && sm[i] < c0 - delta) {
+      i_cross = i;
+      break;
+    }
+  const size_t m_after = std::min(i_end, i_cross + std::max<size_t>(8, n / 20));
+  const double s_after = -slopeOver(t, sm, seg.dropout, i_cross, m_after);
+  seg.has_plateau = s_after > 0.0 && i_cross > 2 && t[i_cross] - t.front() > 3.0 * delta / s_after;
+  seg.drive_off_s = seg.has_plateau ? t[i_cross] - delta / s_after : t.front();
+  seg.plateau_log_amplitude = c0;
+  const double best_c = c0;
+  size_t i_start = seg.has_plateau ? i_cross : 0;
+  if (i_end <= i_start + 8) throw AnalysisError("ring-down: no decay above the noise floor");
+  seg.i_start = i_start;
+  seg.i_end = i_end;
+  for (size_t i = i_start; i < i_end; ++i) {
+    if (seg.dropout[i])
+      ++seg.n_dropouts_in_span;
+    else
+      ++seg.n_used;
+  }
+  // Decay over the span from the smoothed envelope.
+  double s_first = std::numeric_limits<double>::quiet_NaN(), s_last = s_first;
+  for (size_t i = i_start; i < i_end; ++i)
+    if (std::isfinite(sm[i])) {
+      if (!std::isfinite(s_first)) s_first = sm[i];
+      s_last = sm[i];
+    }
+  seg.decay_db = (s_first - s_last) * kDbPerNeper;
+  if (i_end > i_start) {
+    seg.t_start_s = t[i_start];
+    seg.t_end_s = t[i_end - 1];
+  }
+  std::ostringstream why;
+  why.precision(4);
+  const std::string unit = env.from_db ? " dB" : " dB re 1 unit";
+  if (seg.has_plateau)
+    why << "drive off at " << seg.drive_off_s << " s (plateau " << best_c * kDbPerNeper << unit
+        << ")";
+  else
+    why << "no plateau: decay from the first sample at " << t.front() << " s";
+  if (seg.has_floor)
+    why << "; floor " << seg.floor_log_amplitude * kDbPerNeper << unit << " from "
+        << seg.floor_start_s << " s, fit ends " << options.floor_margin_db << " dB above it at "
+        << seg.t_end_s << " s";
+  else
+    why << "; no noise floor reached (decay to the end, " << seg.t_end_s << " s)";
+  why << "; " << seg.n_dropouts_in_span << " drop-outs left out of " << (i_end - i_start)
+      << " samples; decay " << seg.decay_db << " dB";
+  seg.why = why.str();
+  if (seg.n_used < 8 ||
+      !(seg.decay_db >= std::max(options.min_decay_db, 10.0 * seg.noise_sd_log * kDbPerNeper)))
+    throw AnalysisError("ring-down: no decay to fit (" + seg.why + ")");
+  return seg;
+}
+
+}  // namespace cvg_bench

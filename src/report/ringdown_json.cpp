@@ -1,0 +1,117 @@
+#include "cvg_bench/report/ringdown_json.h"
+
+#include <cmath>
+
+namespace cvg_bench {
+namespace report {
+namespace {
+
+nlohmann::json num(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
+nlohmann::json valueJson(const RingdownValue& v) {
+  nlohmann::json j = {{"value", num(v.value)},
+                      {"std", num(v.std)},
+                      {"ci_low", num(v.ci_low)},
+                      {"ci_high", num(v.ci_high)}};
+  if (v.crb_std > 0.0) j["crb_std"] = num(v.crb_std);
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json ringdownFitToJson(const RingdownFit& fit, const RingdownSegment& seg,
+                                 double confidence, const std::vector<std::string>& notes) {
+  nlohmann::json j;
+  j["mode"] = "ringdown";
+  j["model"] = fit.model;
+  j["method"] = "wls_log";
+  j["frequency_hz"] = num(fit.frequency_hz);
+  j["omega"] = num(2.0 * M_PI * fit.frequency_hz);
+  j["q_convention"] = "Q = omega tau / 2 = pi f tau, tau the amplitude (not energy) time constant";
+  j["n_equations"] = fit.n;
+  j["n_params"] = fit.n_params;
+  j["rank"] = fit.rank;
+  j["unidentifiable"] = nlohmann::json::array();
+  j["sigma"] = num(fit.sigma);
+  j["rms_residual_db"] = num(fit.rms_log * 20.0 / std::log(10.0));
+  j["residual_lag1_correlation"] = num(fit.rho1);
+  j["confidence"] = confidence;
+  j["segment"] = {{"t_start", seg.t_start_s},
+                  {"t_end", seg.t_end_s},
+                  {"why", seg.why},
+                  {"has_plateau", seg.has_plateau},
+                  {"drive_off_s", seg.drive_off_s},
+                  {"has_floor", seg.has_floor},
+                  {"floor_db", seg.has_floor ? num(seg.floor_log_amplitude * 20.0 / std::log(10.0))
+                                             : nlohmann::json()},
+                  {"n_used", seg.n_used},
+                  {"n_dropouts", seg.n_dropouts_in_span},
+                  {"decay_db", num(seg.decay_db)}};
+  j["error_model"] = {{"name", fit.error_model}, {"why", fit.error_model_why}};
+  nlohmann::json params = nlohmann::json::object(), derived = nlohmann::json::object(),
+                 dci = nlohmann::json::object(), crb = nlohmann::json::object();
+  for (const auto& kv : fit.parameters) params[kv.first] = valueJson(kv.second);
+  for (const auto& kv : fit.derived) {
+    derived[kv.first] = num(kv.second.value);
+    dci[kv.first] = valueJson(kv.second);
+    if (kv.second.crb_std > 0.0)
+      crb[kv.first] = {{"crb_std", num(kv.second.crb_std)},
+                       {"interval_std_over_crb", num(kv.second.std / kv.second.crb_std)}};
+  }
+  j["parameters"] = params;
+  j["derived"] = derived;
+  j["derived_ci"] = dci;
+  j["cramer_rao"] = crb;
+  j["interval_method"] = fit.interval_method;
+  nlohmann::json qa = nlohmann::json::array();
+  for (const auto& b : fit.q_vs_amplitude)
+    qa.push_back({{"amplitude", num(b.amplitude)},
+                  {"level_db", num(b.level_db)},
+                  {"t_start", b.t_start_s},
+                  {"t_end", b.t_end_s},
+                  {"n", b.n},
+                  {"decay_rate_1_s", num(b.decay_rate_1_s)},
+                  {"Q", valueJson(b.Q)}});
+  j["q_vs_amplitude"] = qa;
+  j["flags"] = fit.flags;
+  j["adequate"] = fit.flags.empty();
+  j["notes"] = notes;
+  return j;
+}
+
+nlohmann::json ringdownExplanationToJson(const RingdownExplanation& x, double confidence,
+                                         const std::vector<std::string>& notes) {
+  nlohmann::json j;
+  j["mode"] = "ringdown";
+  j["baseline"] = {{"model", "linear"}, {"sigma", num(x.baseline.sigma)}};
+  nlohmann::json steps = nlohmann::json::array();
+  for (const auto& s : x.steps)
+    steps.push_back({{"added", s.added},
+                     {"model", "linear+" + s.added},
+                     {"sigma", num(s.sigma)},
+                     {"sigma_ratio", num(s.sigma_ratio)},
+                     {"lr_statistic", num(s.lr_statistic)},
+                     {"threshold", num(s.threshold)},
+                     {"n_eff", num(s.n_eff)},
+                     {"p_value", num(s.p_value)},
+                     {"significant", s.significant},
+                     {"sign_check_passed", s.physical},
+                     {"accepted", s.accepted},
+                     {"note", s.note}});
+  j["steps"] = steps;
+  j["selected"] = x.selected;
+  j["unexplained"] = x.unexplained;
+  j["adequate"] = x.adequate;
+  j["causes"] = x.causes;
+  j["lack_of_fit"] = {{"test", x.lack_of_fit_test}, {"p_value", num(x.lack_of_fit_p)}};
+  j["cause"] = x.cause;
+  j["final"] = ringdownFitToJson(x.final_fit, x.segment, confidence, notes);
+  j["final"]["model"] = x.selected.empty() ? "linear" : "linear+" + x.selected.front();
+  j["final"]["adequate"] = x.adequate;
+  return j;
+}
+
+}  // namespace report
+}  // namespace cvg_bench

@@ -1,0 +1,90 @@
+// Known-answer tests of the ring-down causes (ringdown_causes.h) on generated records.
+#include "cvg_bench/core/diagnose/ringdown_causes.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cvg_bench/core/simulate/ringdown_simulator.h"
+
+namespace cvg_bench {
+namespace {
+
+RingdownSimulationOptions bench(uint32_t seed) {
+  RingdownSimulationOptions o;
+  o.frequency_hz = 5.0e3;
+  o.q = 1.0e5;  // g0 = 0.157 1/s
+  o.noise_db = 0.1;
+  o.floor_db = -60.0;
+  o.n_samples = 2000;
+  o.noise_correlation = 0.5;
+  o.seed = seed;
+  return o;
+}
+
+RingdownExplanation explainOf(const RingdownSimulationOptions& o) {
+  return explainRingdown(ringdownEnvelope(simulateRingdown(o)));
+}
+
+TEST(RingdownCauses, CleanDecayNeedsNoExtension) {
+  const RingdownExplanation x = explainOf(bench(11));
+  EXPECT_TRUE(x.selected.empty()) << x.cause;
+  EXPECT_FALSE(x.unexplained) << x.cause;
+  EXPECT_TRUE(x.adequate);
+  EXPECT_EQ(x.causes.front(), "noise_floor");
+}
+
+TEST(RingdownCauses, AmplitudeSquaredDamping) {
+  RingdownSimulationOptions o = bench(12);
+  o.gamma_nl = 0.157;
+  const RingdownExplanation x = explainOf(o);
+  ASSERT_EQ(x.selected.size(), 1u) << x.cause;
+  EXPECT_EQ(x.selected.front(), "gamma_nl") << x.cause;
+  const RingdownValue& q0 = x.final_fit.derived.at("Q0");
+  EXPECT_NEAR(q0.value, o.q, 4 * q0.std);
+}
+
+TEST(RingdownCauses, AmplitudeLinearDamping) {
+  RingdownSimulationOptions o = bench(13);
+  o.gamma_a = 0.25;
+  const RingdownExplanation x = explainOf(o);
+  ASSERT_EQ(x.selected.size(), 1u) << x.cause;
+  EXPECT_EQ(x.selected.front(), "gamma_a") << x.cause;
+}
+
+TEST(RingdownCauses, BeatGivesTheSplitAndBothRates) {
+  RingdownSimulationOptions o = bench(14);
+  o.split_hz = 0.5;  // 0.5 Hz split over a ~60 s decay
+  o.second_amplitude = 0.3;
+  o.q2 = 0.7e5;
+  const RingdownExplanation x = explainOf(o);
+  ASSERT_EQ(x.selected.size(), 1u) << x.cause;
+  EXPECT_EQ(x.selected.front(), "beat") << x.cause;
+  const RingdownValue& s = x.final_fit.derived.at("frequency_split_hz");
+  EXPECT_NEAR(s.value, 0.5, std::max(4 * s.std, 1e-3));
+  const RingdownValue& q1 = x.final_fit.derived.at("Q_mode1");
+  const RingdownValue& q2 = x.final_fit.derived.at("Q_mode2");
+  EXPECT_NEAR(q1.value, 1.0e5, 4 * q1.std);
+  EXPECT_NEAR(q2.value, 0.7e5, 4 * q2.std);
+}
+
+TEST(RingdownCauses, TwoStageDecay) {
+  RingdownSimulationOptions o = bench(15);
+  o.two_stage_ratio = 3.0;
+  o.q_fast = 1.0e4;
+  const RingdownExplanation x = explainOf(o);
+  ASSERT_EQ(x.selected.size(), 1u) << x.cause;
+  EXPECT_EQ(x.selected.front(), "two_stage") << x.cause;
+}
+
+TEST(RingdownCauses, DetectionLossIsUnexplainedNotADampingLaw) {
+  RingdownSimulationOptions o = bench(16);
+  o.detection_loss_db = 8.0;
+  const RingdownExplanation x = explainOf(o);
+  EXPECT_TRUE(x.unexplained) << x.cause;
+  EXPECT_FALSE(x.adequate);
+  for (const auto& s : x.selected) EXPECT_NE(s, "gamma_nl") << x.cause;
+}
+
+}  // namespace
+}  // namespace cvg_bench

@@ -1,0 +1,106 @@
+// Known-answer tests of the ring-down segmentation and fit on records of the ring-down generator.
+#include "cvg_bench/core/estimate/ringdown_fit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/simulate/ringdown_simulator.h"
+
+namespace cvg_bench {
+namespace {
+
+RingdownSimulationOptions bench() {
+  RingdownSimulationOptions o;
+  o.frequency_hz = 1.0e4;
+  o.q = 2.0e5;  // tau = Q / (pi f) = 6.37 s
+  o.noise_db = 0.1;
+  o.floor_db = -60.0;
+  o.n_samples = 2000;
+  o.dropouts = 5;
+  o.seed = 3;
+  return o;
+}
+
+RingdownFit fitOf(const RingdownRecord& r, RingdownSegment* seg_out = nullptr,
+                  const std::string& model = "linear") {
+  const RingdownEnvelope env = ringdownEnvelope(r);
+  const RingdownSegment seg = segmentRingdown(env);
+  if (seg_out) *seg_out = seg;
+  return fitRingdown(env, seg, model);
+}
+
+TEST(RingdownFit, PlateauFloorAndDropOutsAreSegmentedAndQIsRecovered) {
+  const RingdownSimulationOptions o = bench();
+  const RingdownRecord r = simulateRingdown(o);
+  RingdownSegment seg;
+  const RingdownFit f = fitOf(r, &seg);
+  const double tau = o.q / (M_PI * o.frequency_hz);
+  const double duration = tau * std::log(1000.0) * 1.3 / 0.9;
+  EXPECT_TRUE(seg.has_plateau);
+  EXPECT_NEAR(seg.drive_off_s, 0.1 * duration, 0.01 * duration);
+  EXPECT_TRUE(seg.has_floor);
+  EXPECT_NEAR(seg.floor_log_amplitude * 20 / std::log(10.0), -60.0, 1.5);
+  // Fit ends 10 dB above the floor: ln(1000 / 3.16) tau after switch-off.
+  EXPECT_NEAR(seg.t_end_s - seg.drive_off_s, tau * std::log(1000.0 / std::sqrt(10.0)), 0.1 * tau);
+  EXPECT_EQ(seg.n_dropouts_in_span + seg.n_used, seg.i_end - seg.i_start);
+  EXPECT_GE(seg.n_dropouts_in_span, 1u);
+  const RingdownValue& q = f.derived.at("Q");
+  EXPECT_GT(o.q, q.ci_low - 1.0 * q.std);
+  EXPECT_LT(o.q, q.ci_high + 1.0 * q.std);
+  EXPECT_LT(q.std / o.q, 0.01);
+  EXPECT_GT(q.crb_std, 0.0);
+  EXPECT_NEAR(f.derived.at("tau_s").value, tau, 4 * f.derived.at("tau_s").std);
+  EXPECT_TRUE(f.flags.empty());
+}
+
+TEST(RingdownFit, ScaleFreeAndDbInputGiveTheSameQ) {
+  RingdownSimulationOptions o = bench();
+  const RingdownFit f1 = fitOf(simulateRingdown(o));
+  o.amplitude = 3e-4;  // the same noise realisation at another scale
+  o.floor_db = -60.0;
+  const RingdownFit f2 = fitOf(simulateRingdown(o));
+  o.output_db = true;
+  o.db_offset = -47.0;
+  const RingdownFit f3 = fitOf(simulateRingdown(o));
+  EXPECT_NEAR(f2.derived.at("Q").value / f1.derived.at("Q").value, 1.0, 1e-9);
+  EXPECT_NEAR(f2.derived.at("Q").std / f1.derived.at("Q").std, 1.0, 1e-6);
+  EXPECT_NEAR(f3.derived.at("Q").value / f1.derived.at("Q").value, 1.0, 1e-8);
+}
+
+TEST(RingdownFit, ErrorModelIsChosenFromTheData) {
+  RingdownSimulationOptions o = bench();
+  o.noise_db = 0.3;
+  o.floor_db = -80.0;
+  o.dropouts = 0;
+  EXPECT_EQ(fitOf(simulateRingdown(o)).error_model, "log");
+  o.noise_db = 0.0;
+  o.floor_db = -50.0;
+  EXPECT_EQ(fitOf(simulateRingdown(o)).error_model, "additive");
+}
+
+TEST(RingdownFit, NoDecayIsRefused) {
+  RingdownSimulationOptions o = bench();
+  o.q = 1e9;  // tau 3e4 s over a 60 s record
+  o.duration_s = 60.0;
+  const RingdownEnvelope env = ringdownEnvelope(simulateRingdown(o));
+  EXPECT_THROW(segmentRingdown(env), AnalysisError);
+}
+
+TEST(RingdownFit, QAgainstAmplitudeShowsAmplitudeSquaredDamping) {
+  RingdownSimulationOptions o = bench();
+  o.gamma_nl = M_PI * o.frequency_hz / o.q;  // doubles the rate at A = 1
+  o.noise_db = 0.05;
+  const RingdownFit f = fitOf(simulateRingdown(o), nullptr, "gamma_nl");
+  ASSERT_GE(f.q_vs_amplitude.size(), 3u);
+  EXPECT_LT(f.q_vs_amplitude.front().Q.value, 0.8 * f.q_vs_amplitude.back().Q.value);
+  const RingdownValue& q0 = f.derived.at("Q0");
+  EXPECT_NEAR(q0.value, o.q, 4 * q0.std);
+  const RingdownValue& g = f.parameters.at("gamma_nl");
+  EXPECT_NEAR(g.value, o.gamma_nl, 4 * g.std);
+  EXPECT_TRUE(f.flags.empty());
+}
+
+}  // namespace
+}  // namespace cvg_bench

@@ -1,0 +1,76 @@
+"""The ring-down contract of interfaces.md ("Single-channel ring-downs") through bin/cvg_ident:
+simulate -> identify / explain --mode ringdown, the JSON fields, exit statuses 1 (no decay) and 2
+(bad input, with file and line). Skipped when the tool is not built."""
+import json
+import os
+import subprocess
+import tempfile
+import unittest
+
+ROOT = os.path.abspath(os.environ.get("CVG_BENCH_ROOT",
+                                      os.path.join(os.path.dirname(__file__), "..", "..")))
+TOOL = os.path.join(ROOT, "bin", "cvg_ident")
+
+
+def run(*args):
+    return subprocess.run([TOOL] + list(args), capture_output=True, text=True)
+
+
+@unittest.skipUnless(os.path.exists(os.path.join(ROOT, "build", "ws", "devel", "lib", "cvg_bench",
+                                                 "cvg_ident")), "tool not built")
+class RingdownCli(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp()
+
+    def path(self, name):
+        return os.path.join(self.tmp, name)
+
+    def test_identify_db_record_gives_q_with_interval_and_segment(self):
+        rec, js = self.path("rd.csv"), self.path("q.json")
+        self.assertEqual(run("simulate", "--mode", "ringdown", "--q", "2e5", "--frequency", "1e4",
+                             "--scale", "db", "--db-offset", "-30", "--dropouts", "3", "--seed",
+                             "4", "--out", rec).returncode, 0)
+        p = run("identify", rec, "--mode", "ringdown", "--model", "linear", "--json", js)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        j = json.load(open(js))
+        self.assertEqual(j["mode"], "ringdown")
+        self.assertAlmostEqual(j["frequency_hz"], 1e4)
+        for k in ("t_start", "t_end", "why"):
+            self.assertIn(k, j["segment"])
+        self.assertIn("drive off", j["segment"]["why"])
+        q = j["derived_ci"]["Q"]
+        half = q["ci_high"] - q["ci_low"]
+        self.assertLess(abs(q["value"] - 2e5), max(2 * half, 0.005 * 2e5))
+        self.assertIn("tau_s", j["derived_ci"])
+        self.assertIn("HAC", j["interval_method"])
+        self.assertGreater(j["cramer_rao"]["Q"]["crb_std"], 0)
+
+    def test_explain_finds_amplitude_squared_damping_and_q0(self):
+        rec, js = self.path("nl.csv"), self.path("x.json")
+        run("simulate", "--mode", "ringdown", "--effect", "gamma_nl=0.3", "--seed", "5", "--out", rec)
+        p = run("explain", rec, "--mode", "ringdown", "--json", js)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        j = json.load(open(js))
+        self.assertEqual(j["selected"], ["gamma_nl"])
+        self.assertFalse(j["unexplained"])
+        self.assertIn("Q0", j["final"]["derived_ci"])
+        q0 = j["final"]["derived_ci"]["Q0"]
+        self.assertLess(q0["ci_low"], 1e5 * 1.02)
+        self.assertGreater(q0["ci_high"], 1e5 * 0.98)
+
+    def test_no_decay_exits_1_and_bad_field_exits_2(self):
+        rec = self.path("flat.csv")
+        run("simulate", "--mode", "ringdown", "--q", "1e12", "--duration-s", "10", "--out", rec)
+        p = run("identify", rec, "--mode", "ringdown", "--model", "linear")
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        self.assertIn("no decay", p.stderr)
+        bad = self.path("bad.csv")
+        with open(bad, "w") as fh:
+            fh.write("% Frequency [Hz]: 1000\ntime [s]; power [dBm]\n0; -10\n0.1; -11\n0.2; x\n")
+        p = run("identify", bad, "--mode", "ringdown", "--model", "linear")
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("bad.csv:5", p.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
