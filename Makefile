@@ -12,7 +12,8 @@ deps:
 	@bash scripts/install_deps.sh
 
 # The package appears in the workspace as build/ws/.src/cvg_bench: a folder holding one link per
-# top-level entry of the repository except build/. A single link back to the repository would put
+# top-level entry of the repository except build/ (hard links for files, so that an install copies
+# package.xml itself, symbolic links for folders). A single link back to the repository would put
 # a loop under the package (the link sits inside build/), which `rosrun` (find -L) reports as
 # "File system loop detected" and roslib's resource search walks repeatedly.
 build: deps
@@ -21,7 +22,9 @@ build: deps
 	@if [ -L $(WS)/.src/cvg_bench ]; then rm $(WS)/.src/cvg_bench; fi
 	@mkdir -p $(WS)/.src/cvg_bench
 	@find $(WS)/.src/cvg_bench -maxdepth 1 -type l -delete
-	@for e in $$(ls -A); do case "$$e" in build|.git) ;; *) ln -sfn "../../../../$$e" "$(WS)/.src/cvg_bench/$$e";; esac; done
+	@for e in $$(ls -A); do case "$$e" in build|.git) ;; \
+	  *) if [ -d "$$e" ]; then ln -sfn "../../../../$$e" "$(WS)/.src/cvg_bench/$$e"; \
+	     else ln -f "$$e" "$(WS)/.src/cvg_bench/$$e"; fi;; esac; done
 	@cd $(WS) && catkin_make --source .src $(CATKIN_ARGS) -j$(JOBS) > ../catkin_build.log 2>&1 \
 	  || { tail -n 60 ../catkin_build.log; echo "make build: failed (full log: build/catkin_build.log)"; exit 1; }
 	@echo "make build: ok (tool: bin/cvg_ident)"
