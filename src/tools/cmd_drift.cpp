@@ -84,7 +84,11 @@ int runDrift(const std::vector<std::string>& argv) {
   if (args.has("theta")) {
     thetas.push_back(args.getDouble("theta", 0.0));
   } else {
-    thetas = thetaGrid(args.getInt("theta-grid", 8));
+    const long n = args.getInt("theta-grid", 8);
+    if (n < 1 || n > kMaxThetaGridPoints)
+      throw InputError("--theta-grid: need 1.." + std::to_string(kMaxThetaGridPoints) +
+                       " pattern angles, got " + std::to_string(n));
+    thetas = thetaGrid(n);
   }
   UncertainParameters up;
   up.values = pf.values;

@@ -78,11 +78,13 @@ DataSufficiency assessFreeDecay(const SlowRecord& record, int n_params) {
                               "; need " + fmt(kMinSignalToNoisePower) + ")";
   if (!f_ok && !g_ok)
     d.reason = "no decay signal above the noise: the record looks like pure noise" + figures;
-  else
+  else {
+    d.coupling_only = true;
     d.reason = std::string("the ") + (f_ok ? "g coordinate (q2, p2)" : "f coordinate (q1, p1)") +
                " carries no signal above the noise, so the terms coupling f and g (nu, b_c, b_s, "
                "h_c, h_s) are not identified" +
                figures;
+  }
   return d;
 }
 
@@ -113,7 +115,7 @@ DataSufficiency assessSweep(const SweepRecord& record, int n_params) {
 
 void requireSufficientData(const SlowRecord& record, int n_params) {
   const DataSufficiency d = assessFreeDecay(record, n_params);
-  if (!d.sufficient)
+  if (!d.sufficient && !d.coupling_only)
     throw AnalysisError((record.source.empty() ? "free decay" : record.source) + ": " + d.reason);
 }
 

@@ -60,9 +60,11 @@ TEST(DataSufficiency, PureNoiseIsRefused) {
   EXPECT_NEAR(d.snr_g, 1.0, 0.3);
 }
 
-TEST(DataSufficiency, SilentSecondCoordinateIsRefused) {
+TEST(DataSufficiency, SilentSecondCoordinateIsNamedNotRefused) {
   const DataSufficiency d = assessFreeDecay(decay(1.0, 0.0, 1e-3), 8);
   EXPECT_FALSE(d.sufficient);
+  EXPECT_TRUE(d.coupling_only);  // identification goes on; collinearity reports the coupling
+  EXPECT_NO_THROW(requireSufficientData(decay(1.0, 0.0, 1e-3), 8));
   EXPECT_NE(d.reason.find("g coordinate"), std::string::npos) << d.reason;
   EXPECT_NE(d.reason.find("not identified"), std::string::npos) << d.reason;
   EXPECT_NEAR(d.snr_g, 1.0, 0.3);

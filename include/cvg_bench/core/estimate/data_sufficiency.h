@@ -25,13 +25,17 @@ struct DataSufficiency {
   std::string reason;  ///< empty when sufficient; else what is missing, with the figures
   double snr_f = 0.0;  ///< free decay: signal/noise power of (q1, p1)
   double snr_g = 0.0;  ///< free decay: signal/noise power of (q2, p2)
+  /// Free decay with one silent coordinate pair: only the f-g coupling terms are undetermined; the
+  /// estimate goes ahead and its identifiability analysis (collinearity.h) reports them as not
+  /// identified with the combinations the record does determine (Q from the envelope).
+  bool coupling_only = false;
 };
 
 /// n_params: parameters of the model to be fitted (residual degrees of freedom must reach it).
 DataSufficiency assessFreeDecay(const SlowRecord& record, int n_params);
 DataSufficiency assessSweep(const SweepRecord& record, int n_params);
 
-/// Throws AnalysisError with the reason when the record is insufficient.
+/// Throws AnalysisError with the reason when the record is insufficient (not for coupling_only).
 void requireSufficientData(const SlowRecord& record, int n_params);
 void requireSufficientData(const SweepRecord& record, int n_params);
 
