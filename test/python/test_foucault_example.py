@@ -65,18 +65,16 @@ class FoucaultExample(unittest.TestCase):
         self.assertAlmostEqual(self.s["r_px"]["end"], 183.1, delta=0.1)
 
     def test_explain_verdict_today(self):
-        # Pinned: explain's selection is being rewritten (subset scoring), so its verdict on this
-        # record may change; this records what the doc reports today (xi then cm_rate, lack of fit,
-        # xi_k significant but refused by the hold-out). Update the doc and this test together.
+        # Pinned: best-subset selection picks xi + cm_rate + kappa and calls it adequate because the
+        # AR(1) whitening (rho ~0.98) absorbs the slow misfit (the unwhitened runs test rejects);
+        # docs/examples/foucault.md says why that verdict is not trusted. Update both together.
         e = self.s["explain"]
-        self.assertEqual(e["selected"], ["xi", "cm_rate"])
-        self.assertTrue(e["unexplained"])
+        self.assertEqual(sorted(e["selected"]), ["cm_rate", "kappa", "xi"])
+        self.assertFalse(e["unexplained"])
+        self.assertLess(e["lack_of_fit"]["p_value_unwhitened"], 1e-6)
         self.assertAlmostEqual(e["baseline"]["sigma"], 7.51, delta=0.01)
         self.assertAlmostEqual(e["steps"][0]["sigma"], 0.714, delta=0.002)
         self.assertAlmostEqual(e["steps"][1]["sigma"], 0.542, delta=0.002)
-        refused = [l for l in e["stdout"] if "not accepted: xi_k" in l]
-        self.assertEqual(len(refused), 1)
-        self.assertIn("hold-out 0.24", refused[0])
 
     def check(self, entry, value, low=None, high=None, rel=0.005):
         self.assertAlmostEqual(entry["value"], value, delta=rel * abs(value))
@@ -86,19 +84,19 @@ class FoucaultExample(unittest.TestCase):
 
     def test_paper_cubic_precesses_the_wrong_way(self):
         xi = self.s["ladder"]["xi"]
-        self.check(xi["parameters"]["xi"], -6.47e-7, -6.60e-7, -6.33e-7)
-        self.check(xi["phi_rate_k0_deg_h"], 1.79, 1.46, 2.11, rel=0.02)
-        self.check(xi["phi_rate_deg_h"], 3.81, 3.51, 4.11, rel=0.01)
-        self.check(self.s["ladder"]["xi (ceres)"]["phi_rate_k0_deg_h"], 1.28, 0.84, 1.71, rel=0.03)
+        self.check(xi["parameters"]["xi"], -6.47e-7, -6.70e-7, -6.23e-7)
+        self.check(xi["phi_rate_k0_deg_h"], 1.79, 1.24, 2.33, rel=0.02)
+        self.check(xi["phi_rate_deg_h"], 3.81, 3.30, 4.32, rel=0.01)
+        self.check(self.s["ladder"]["xi (ceres)"]["phi_rate_k0_deg_h"], 1.28, -1.42, 3.97, rel=0.03)
 
     def test_extended_model(self):
         ls, ce = self.s["ladder"]["xi+xi_k"], self.s["ladder"]["xi+xi_k (ceres)"]
-        self.check(ls["precession_coupling"], 9.4e-7, 4.0e-7, 14.8e-7, rel=0.01)
-        self.check(ce["precession_coupling"], 2.26e-6, 2.04e-6, 2.49e-6, rel=0.01)
-        self.check(ls["phi_rate_k0_deg_h"], 8.81, 6.51, 11.11, rel=0.005)
-        self.check(ce["phi_rate_k0_deg_h"], 12.93, 11.38, 14.47, rel=0.01)
-        self.check(ls["phi_rate_deg_h"], 5.02, 4.59, 5.44, rel=0.01)
-        self.check(ce["phi_rate_deg_h"], 4.24, 3.07, 5.41, rel=0.02)
+        self.check(ls["precession_coupling"], 9.36e-7, 1.59e-7, 17.12e-7, rel=0.01)
+        self.check(ce["precession_coupling"], 2.26e-6, 1.25e-6, 3.27e-6, rel=0.01)
+        self.check(ls["phi_rate_k0_deg_h"], 8.81, 5.47, 12.15, rel=0.005)
+        self.check(ce["phi_rate_k0_deg_h"], 12.93, 5.73, 20.12, rel=0.01)
+        self.check(ls["phi_rate_deg_h"], 5.02, 4.27, 5.77, rel=0.01)
+        self.check(ce["phi_rate_deg_h"], 4.24, -1.32, 9.80, rel=0.02)
         self.assertAlmostEqual(self.s["ladder"]["xi (ceres)"]["sigma"], 0.714, delta=0.002)
         self.assertAlmostEqual(ce["sigma"], 0.529, delta=0.002)
         self.assertAlmostEqual(self.s["physics"]["sigma_gain_over_paper_cubic_ceres"], 1.35,
@@ -107,16 +105,16 @@ class FoucaultExample(unittest.TestCase):
                                delta=0.0005)
         self.assertAlmostEqual(self.s["physics"]["pixels_per_m_from_coupling"], 967, delta=5)
         self.assertAlmostEqual(self.s["physics"]["foucault_deg_h"], 10.40, delta=0.005)
-        # The LS swing rate's interval contains Foucault's 10.40 deg/h; the Ceres one does not.
-        self.assertLess(ls["phi_rate_k0_deg_h"]["ci_low"], 10.40)
-        self.assertGreater(ls["phi_rate_k0_deg_h"]["ci_high"], 10.40)
-        self.assertGreater(ce["phi_rate_k0_deg_h"]["ci_low"], 10.40)
+        # Both swing-rate intervals (correlation-honest) contain Foucault's 10.40 deg/h.
+        for fit in (ls, ce):
+            self.assertLess(fit["phi_rate_k0_deg_h"]["ci_low"], 10.40)
+            self.assertGreater(fit["phi_rate_k0_deg_h"]["ci_high"], 10.40)
 
     def test_quality_factor(self):
         self.assertAlmostEqual(self.s["Q_envelope_record"], 4970, delta=10)
         ce = self.s["ladder"]["xi+xi_k (ceres)"]["envelope"]
         ls = self.s["ladder"]["xi+xi_k"]["envelope"]
-        for e, q, lo, hi in ((ce, 4874, 4750, 5004), (ls, 4481, 4393, 4572)):
+        for e, q, lo, hi in ((ce, 4874, 4338, 5560), (ls, 4481, 4295, 4683)):
             self.assertAlmostEqual(e["Q"], q, delta=20)
             self.assertAlmostEqual(e["Q_ci_low"], lo, delta=20)
             self.assertAlmostEqual(e["Q_ci_high"], hi, delta=20)
