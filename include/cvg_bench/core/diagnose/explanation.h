@@ -1,5 +1,5 @@
 // `explain`: what the linear model gets wrong, the physical cause, the extended model and the gain
-// (issue 5; the paper's own story: the linear model leaves a systematic error in the forced
+// (the paper's own story: the linear model leaves a systematic error in the forced
 // response, Fig. 2; cubic stiffness removes it, Fig. 3, residual std 0.295 -> 0.0926).
 //
 // Steps: (1) fit the linear baseline and read its residual signature (residual_signature.h);

@@ -1,4 +1,4 @@
-// Selection of model extensions for `explain`: best subset up to max_terms candidates (issue 11),
+// Selection of model extensions for `explain`: best subset up to max_terms candidates,
 // ranked on the cheap equation-error LS fit, decided on the refined (output-error) fits of the
 // finalists, confirmed on a hold-out (subset_selection.cpp has the procedure).
 //

@@ -1,4 +1,4 @@
-// The noise model under which `explain`'s adequacy test is calibrated (issue 11: the lack-of-fit
+// The noise model under which `explain`'s adequacy test is calibrated (the lack-of-fit
 // verdict must hold its false-alarm rate on demodulated records and coloured noise).
 //
 // Residuals of an adequate model are the measurement noise; when that noise is correlated, sign
