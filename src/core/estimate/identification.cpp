@@ -270,7 +270,7 @@ HonestCovariance sweepCovariance(const BlockStream& stream, const SystemInfo& in
   // sum of sc sc' with sc = D_j' r_j: four points' scores are the rows of one Gram block.
   BlockGramAccumulator meat(k);
   RegressionBlockMatrix scores = RegressionBlockMatrix::Zero(4, k);
-  std::vector<double> all_scores;  // per point, k each, in order (for HAC)
+  long points = 0;
   ResidualLagAccumulator lags(1);
   int in_block = 0, last_record = -1;
   stream([&](int record, const RegressionBlock& b) {
@@ -280,7 +280,7 @@ HonestCovariance sweepCovariance(const BlockStream& stream, const SystemInfo& in
     h.rss += r.squaredNorm();
     lags.add(r);
     scores.row(in_block).noalias() = r.transpose() * (*b.d);
-    for (int j = 0; j < k; ++j) all_scores.push_back(scores(in_block, j));
+    ++points;
     if (++in_block == 4) {
       meat.add(scores);
       in_block = 0;
@@ -292,12 +292,14 @@ HonestCovariance sweepCovariance(const BlockStream& stream, const SystemInfo& in
   }
   const SerialCorrelationTest test = testLagOne(lags.correlations()[0], 0.0, 1.0, lags.steps());
   recordCorrelationTest(test, e);
-  const long points = static_cast<long>(all_scores.size()) / k;
   h.dof = static_cast<int>(std::max(1L, info.num_clusters - 1));
   if (test.correlated && points >= 3 * k) {
-    const Eigen::MatrixXd g =
-        Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-            all_scores.data(), points, k);
+    // Second pass only when HAC is needed: the per-point scores in order (points x k).
+    Eigen::MatrixXd g(points, k);
+    long row = 0;
+    stream([&](int, const RegressionBlock& b) {
+      g.row(row++).noalias() = blockResidual(*b.d, z, b.y).transpose() * (*b.d);
+    });
     const HacCovariance hac = hacCovarianceFromScores(g, s.ls.r_pinv, s.n, s.ls.rank);
     h.covariance = hac.covariance;
     e->interval_method_id = "hac_bartlett_andrews";
