@@ -5,6 +5,13 @@ WS := build/ws
 JOBS ?= 2
 export PATH := /usr/bin:/bin:$(PATH)
 CATKIN_ARGS := -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release -DCATKIN_ENABLE_TESTING=ON
+# ccache, where installed, shares compiled objects between rebuilds and worktrees (paths made
+# relative to the tree, so identical sources in another checkout hit the cache). Not needed by CI.
+ifneq ($(shell command -v ccache 2>/dev/null),)
+CATKIN_ARGS += -DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache
+export CCACHE_BASEDIR := $(CURDIR)
+export CCACHE_NOHASHDIR := 1
+endif
 
 .PHONY: deps build demo test bench format clean
 
