@@ -69,6 +69,11 @@ void DemodulatorNode::onRaw(const RawSampleBatch::ConstPtr& msg) {
   if (have_seq_ && msg->header.seq > last_seq_) batches_lost_ += msg->header.seq - last_seq_ - 1;
   have_seq_ = true;
   last_seq_ = msg->header.seq;
+  // An empty batch marks the end of a record (its sequence number above counted any lost tail).
+  if (msg->f.empty() && msg->g.empty() && msg->time_offsets_s.empty()) {
+    ++end_markers_;
+    return;
+  }
   const ros::Time now = ros::Time::now();
   // A /clock that jumps back (replay restarted) is reported; the reset itself is decided by the
   // data's own stamps below, so a batch processed before the clock message is not reset twice.
@@ -173,6 +178,7 @@ void DemodulatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   samples_in_at_last_diag_ = samples_in_;
   stat.add("raw_samples_received", samples_in_);
   stat.add("batches_lost_in_transport", batches_lost_);
+  stat.add("end_of_record_markers", end_markers_);
   stat.add("raw_queue_size", options_.raw_queue_size);
   stat.add("rejected_total", rejected);
   stat.add("batches", batches_);

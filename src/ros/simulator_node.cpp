@@ -254,9 +254,22 @@ void SimulatorNode::publishDueFreeDecay(double due_s) {
   }
   if ((!raw_stream_ || raw_stream_->produced() >= raw_stream_->total()) &&
       slow_next_ >= slow_.size()) {
+    if (raw_stream_) publishEndOfRawRecord();
     running_ = Running::kNone;
     ROS_INFO("free decay finished (%.6g s simulated)", due_s);
   }
+}
+
+// An empty batch after the record's last samples: its sequence number shows a subscriber the
+// batches lost at the very end (a gap is otherwise only seen by the next message).
+void SimulatorNode::publishEndOfRawRecord() {
+  RawSampleBatch end;
+  end.header.stamp = timeAfter(start_stamp_, raw_stream_->timeOf(raw_stream_->total() - 1));
+  end.header.frame_id = options_.frame_id;
+  end.sample_rate_hz = preset_.raw_sample_rate_hz;
+  end.phase_epoch = start_stamp_;
+  end.omega_rad_s = preset_.omega_rad_s;
+  raw_pub_.publish(end);
 }
 
 void SimulatorNode::publishDueSweep(double wall_elapsed_s) {

@@ -121,12 +121,14 @@ class LoadCheck(unittest.TestCase):
         self.assertLessEqual(largest, MAX_BATCH)
         # Every loss counted.
         received_raw = int(demod["raw_samples_received"])
-        # Sequence gaps count every lost batch but the last ones (no later message shows the
-        # gap): what is missing beyond the counted batches is at most the final two batches.
+        # Sequence gaps count every lost batch, the last ones too: the simulator's empty
+        # end-of-record batch follows them (RawSampleBatch.msg).
         lost = int(demod["batches_lost_in_transport"])
+        self.assertEqual(int(demod["end_of_record_markers"]), 1)
         self.assertLessEqual(received_raw, n_record)
-        self.assertLessEqual(n_record - received_raw, (lost + 2) * MAX_BATCH)
-        tail_short = n_record - received_raw if lost == 0 else None
+        self.assertLessEqual(n_record - received_raw, lost * MAX_BATCH)
+        self.assertEqual(received_raw == n_record, lost == 0)
+        missing = n_record - received_raw
         published_slow = int(demod["slow_states_published"])
         self.assertEqual(int(ident["received"]) + int(ident["dropped_in_transport"]), published_slow)
         rss = {k: peak_rss_mb(n) for k, n in NODES.items()}
@@ -139,7 +141,7 @@ class LoadCheck(unittest.TestCase):
             "simulator_max_lag_s": float(sim["max_lag_s"]),
             "ticks_capped": int(sim["ticks_capped_at_max_batch_samples"]),
             "demod_batches_lost": lost,
-            "demod_raw_received": received_raw, "demod_uncounted_tail_samples": tail_short,
+            "demod_raw_received": received_raw, "demod_raw_samples_missing": missing,
             "slow_states_published": published_slow,
             "ident_received": int(ident["received"]),
             "ident_dropped_in_transport": int(ident["dropped_in_transport"]),

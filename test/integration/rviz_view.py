@@ -68,8 +68,9 @@ class RvizView(unittest.TestCase):
         self.lock = threading.Lock()
         self.estimate = None
         self.markers = None
-        rospy.Subscriber("/cvg/estimate", ModelEstimate, self.on_estimate)
-        rospy.Subscriber("/cvg/markers", MarkerArray, self.on_markers)
+        self.ns = rospy.get_param("~ns", "/cvg")
+        rospy.Subscriber(self.ns + "/estimate", ModelEstimate, self.on_estimate)
+        rospy.Subscriber(self.ns + "/markers", MarkerArray, self.on_markers)
 
     def on_estimate(self, msg):
         with self.lock:
@@ -97,8 +98,10 @@ class RvizView(unittest.TestCase):
         rviz = None
         try:
             time.sleep(1.0)  # Xvfb accepts clients
+            # As launch/bench_sim.launch starts it: in the gyro's namespace, -f its resonator frame.
             rviz = subprocess.Popen(["rosrun", "rviz", "rviz", "-d", rospy.get_param("~rviz_config"),
-                                     "__name:=rviz_view_test_rviz"], env=env,
+                                     "-f", rospy.get_param("~frame_prefix", "") + "resonator",
+                                     "__name:=rviz_view_test_rviz", "__ns:=" + self.ns], env=env,
                                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             self.assertTrue(self.wait_for(
                 lambda: self.markers is not None and self.estimate is not None

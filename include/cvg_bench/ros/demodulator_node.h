@@ -63,6 +63,7 @@ class DemodulatorNode {
   bool have_seq_ = false;
   uint32_t last_seq_ = 0;
   uint64_t batches_lost_ = 0, samples_in_ = 0, samples_in_at_last_diag_ = 0;
+  uint64_t end_markers_ = 0;  // empty batches: end-of-record markers of the simulator
   ros::WallTime last_diag_wall_;
 };
 

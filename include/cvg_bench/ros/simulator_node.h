@@ -44,6 +44,7 @@ class SimulatorNode {
   void beginStreaming(Running what, ExperimentMode mode, const ResonatorPreset& preset);
   void onTick(const ros::WallTimerEvent&);
   void publishDueFreeDecay(double due_s);
+  void publishEndOfRawRecord();
   void publishDueSweep(double wall_elapsed_s);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   /// Autostart: starts once the experiment's first consumer is connected; warns once when only
