@@ -9,9 +9,16 @@ ResidualLagAccumulator::ResidualLagAccumulator(int max_lag)
 
 void ResidualLagAccumulator::add(const Eigen::Vector4d& r) {
   sum_sq_ += r.squaredNorm();
-  const long avail = std::min<long>(in_record_, max_lag_);
-  for (long l = 1; l <= avail; ++l) cross_[l - 1] += r.dot(ring_[(in_record_ - l) % max_lag_]);
-  ring_[in_record_ % max_lag_] = r;
+  // ring_[head_] is the next slot; the previous residuals sit at head_ - 1, head_ - 2, ...
+  // (wrapped without a division per lag: this runs once per time step of a 10^6-sample record).
+  const int avail = static_cast<int>(std::min<long>(in_record_, max_lag_));
+  int slot = head_;
+  for (int l = 0; l < avail; ++l) {
+    slot = slot == 0 ? max_lag_ - 1 : slot - 1;
+    cross_[l] += r.dot(ring_[slot]);
+  }
+  ring_[head_] = r;
+  head_ = head_ + 1 == max_lag_ ? 0 : head_ + 1;
   ++in_record_;
   ++steps_;
 }

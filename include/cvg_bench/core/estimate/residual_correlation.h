@@ -15,7 +15,7 @@ class ResidualLagAccumulator {
   /// The next time step's residual 4-vector.
   void add(const Eigen::Vector4d& r);
   /// The following residuals start a new record.
-  void startRecord() { in_record_ = 0; }
+  void startRecord() { in_record_ = 0; head_ = 0; }
   std::vector<double> correlations() const;
   long steps() const { return steps_; }
 
@@ -25,6 +25,7 @@ class ResidualLagAccumulator {
   std::vector<double> cross_;
   double sum_sq_ = 0.0;
   long in_record_ = 0, steps_ = 0;
+  int head_ = 0;
 };
 
 /// Two-sided test of the lag-1 correlation: z = (c_1 - expected) / sqrt(variance_factor / steps)
