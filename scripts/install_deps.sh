@@ -16,6 +16,7 @@ PACKAGES=(
   libvisualization-msgs-dev python3-visualization-msgs
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   rviz xvfb x11-apps
+  clang-14 libclang-rt-14-dev
 )
 
 missing=()

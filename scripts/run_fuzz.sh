@@ -16,7 +16,10 @@ if [ -f "$msg_include/cvg_bench/SlowState.h" ]; then
 else
   echo "fuzz: no generated message headers (run make build first): the bag reader is skipped"
 fi
+# EIGEN_MALLOC_ALREADY_ALIGNED=1: as in scripts/run_asan_tests.sh (Eigen code shared with the
+# uninstrumented libraries must allocate and free alike).
 san="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -g -O1"
+san+=" -DEIGEN_MALLOC_ALREADY_ALIGNED=1"
 cmake -S "$root" -B "$b" -DCVG_CORE_ONLY=ON -DCVG_FUZZ=ON -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_CXX_FLAGS_RELEASE="-DNDEBUG" -DCMAKE_CXX_FLAGS="$san" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" "${extra[@]}" \

@@ -530,16 +530,43 @@ class BadInputSuite(unittest.TestCase):
                  os.path.join(outs, "e.json"), "--report", os.path.join(outs, "rep"),
                  "--no-figures"],
                 ["drift", "--params", self.base_json_path, "--json", os.path.join(outs, "d.json")],
-                ["demod", self.raw_path, "--rate", "2000", "--out", os.path.join(outs, "s.csv")]]
+                ["demod", self.raw_path, "--rate", "2000", "--out", os.path.join(outs, "s.csv")],
+                ["simulate", "--preset", "mems_ring", "--mode", "free_decay", "--seed", "7",
+                 "--duration", "0.5", "--out", os.path.join(outs, "sim.csv")]]
         for args in runs:
             p = subprocess.run([TOOL] + args, cwd=cwd, stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, universal_newlines=True, timeout=120)
             self.assertEqual(p.returncode, 0, p.stderr)
         self.assertEqual(os.listdir(cwd), [])
-        self.assertEqual(sorted(os.listdir(outs)), ["d.json", "e.json", "i.json", "rep", "s.csv"])
+        self.assertEqual(sorted(os.listdir(outs)),
+                         ["d.json", "e.json", "i.json", "rep", "s.csv", "sim.csv"])
         self.assertTrue(set(os.listdir(os.path.join(outs, "rep"))) <=
                         {"explain.json", "curves.csv", "residuals.csv", "signature.csv",
                          "report.md"})
+
+    def test_nodes_write_no_files(self):
+        """The nodes take no output path (none in a service request, parameter or topic): their
+        sources open no file for writing, and no service field names a path, file or directory."""
+        writers = ("ofstream", "fopen", "FILE *", "FILE*", "bagmode::Write", "bagmode::Append",
+                   "std::filesystem", "mkdir", "rename(", "unlink(", "creat(", "O_CREAT",
+                   "writeJsonFile", "writeRecordCsv", "writeReport")
+        files = [os.path.join(d, f) for d in ("src/ros", "src/nodes", "include/cvg_bench/ros")
+                 for f in sorted(os.listdir(os.path.join(ROOT, d)))]
+        self.assertGreater(len(files), 10)
+        for path in files:
+            with open(os.path.join(ROOT, path)) as f:
+                text = f.read()
+            for w in writers:
+                self.assertNotIn(w, text, "%s writes files (%s)" % (path, w))
+        srv_dir = os.path.join(ROOT, "srv")
+        for name in sorted(os.listdir(srv_dir)):
+            with open(os.path.join(srv_dir, name)) as f:
+                request = f.read().split("---")[0]
+            for line in request.splitlines():
+                field = line.split("#")[0].split()
+                if len(field) == 2:
+                    self.assertFalse(any(k in field[1].lower() for k in ("path", "file", "dir")),
+                                     "%s: request field %s names a location" % (name, field[1]))
 
     # ---- drift --params JSON --------------------------------------------------------------------
     def test_params_json(self):

@@ -6,7 +6,10 @@
 
 #include <cstring>
 
-// The vectors never cross an ABI boundary (inline helpers of two translation units).
+// The vectors never cross an ABI boundary: every helper taking or returning a V4 by value is
+// always_inline. An out-of-line copy (-O0, or the inliner declining) is compiled for the default
+// target and returns the vector in memory, while a CVG_HOT_CLONES caller built for x86-64-v3
+// expects it in a ymm register: at -O0 the validator read through a garbage pointer.
 #pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace cvg_bench {
@@ -14,13 +17,13 @@ namespace simd {
 
 using V4 = double __attribute__((vector_size(32)));
 
-inline V4 load4(const double* p) {
+__attribute__((always_inline)) inline V4 load4(const double* p) {
   V4 v;
   std::memcpy(&v, p, sizeof(v));
   return v;
 }
 
-inline void store4(double* p, const V4& v) {
+__attribute__((always_inline)) inline void store4(double* p, const V4& v) {
   std::memcpy(p, &v, sizeof(v));
 }
 
