@@ -65,6 +65,9 @@ nlohmann::json ringdownFitToJson(const RingdownFit& fit, const RingdownSegment& 
   j["derived_ci"] = dci;
   j["cramer_rao"] = crb;
   j["interval_method"] = fit.interval_method;
+  j["residual_noise_model"] = {{"ar_order", fit.noise_ar_order},
+                               {"long_run_variance_factor", num(fit.long_run_factor)},
+                               {"effective_n", num(fit.effective_n)}};
   nlohmann::json qa = nlohmann::json::array();
   for (const auto& b : fit.q_vs_amplitude)
     qa.push_back({{"amplitude", num(b.amplitude)},
@@ -99,8 +102,15 @@ nlohmann::json ringdownExplanationToJson(const RingdownExplanation& x, double co
                      {"significant", s.significant},
                      {"sign_check_passed", s.physical},
                      {"accepted", s.accepted},
+                     {"information_criterion", num(s.information_criterion)},
+                     {"hold_out_error", num(s.hold_out_error)},
+                     {"hold_out_reference", num(s.hold_out_reference)},
                      {"note", s.note}});
   j["steps"] = steps;
+  j["selection"] = {{"criterion",
+                     "BIC on the effective sample size; beat and two_stage must also "
+                     "beat the physical amplitude laws; pick confirmed on hold-out"},
+                    {"information_criterion", x.information_criterion}};
   j["selected"] = x.selected;
   j["unexplained"] = x.unexplained;
   j["adequate"] = x.adequate;

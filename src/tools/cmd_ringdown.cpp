@@ -261,8 +261,9 @@ int runRingdownExplain(const std::vector<std::string>& argv) {
   for (const auto& s : x.steps) {
     char buf[300];
     std::snprintf(buf, sizeof(buf),
-                  "  + %-10s sigma ratio %7.4f  LR %10.4g (threshold %.3g, n_eff %.0f)  %s%s\n",
-                  s.added.c_str(), s.sigma_ratio, s.lr_statistic, s.threshold, s.n_eff,
+                  "  + %-10s sigma ratio %7.4f  BIC %10.4g (linear %.4g, n_eff %.0f)  %s%s\n",
+                  s.added.c_str(), s.sigma_ratio, s.information_criterion,
+                  x.information_criterion.at("linear"), s.n_eff,
                   s.accepted ? "ACCEPTED" : "rejected: ", s.accepted ? "" : s.note.c_str());
     std::cout << buf;
   }

@@ -3,18 +3,18 @@
 #include <Eigen/Dense>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
-#include "cvg_bench/core/estimate/hac_covariance.h"
+#include "cvg_bench/core/estimate/ringdown_intervals.h"
 #include "cvg_bench/core/estimate/ringdown_models.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {
 
-double chi2Quantile(int df, double p_upper) {
-  return boost::math::quantile(boost::math::complement(boost::math::chi_squared(df), p_upper));
-}
+const double kInfinity = std::numeric_limits<double>::infinity();
+
 double chi2Upper(int df, double x) {
   if (!(x > 0.0)) return 1.0;
   return boost::math::cdf(boost::math::complement(boost::math::chi_squared(df), x));
@@ -37,7 +37,7 @@ std::string signCheck(const RingdownFit& f) {
              "falls: no physical damping law)";
   } else if (f.model == "beat") {
     if (p(1) <= 0.0 || p(3) <= 0.0) return "a mode's decay rate fitted negative";
-    if (p(4) < 2.0 * M_PI) return "split under one beat period in the span";
+    if (p(4) < 4.0 * M_PI) return "under two beat periods in the span (a step is not a beat)";
     if (p(2) - p(0) < std::log(0.005)) return "second mode below 0.5 % of the first";
   } else if (f.model == "two_stage") {
     if (p(1) <= 0.0 || p(3) <= 0.0) return "a stage's decay rate fitted negative";
@@ -51,6 +51,7 @@ std::string signCheck(const RingdownFit& f) {
 std::vector<std::string> RingdownExplainOptions::validate() const {
   std::vector<std::string> out = fit.validate();
   if (!(alpha > 0.0 && alpha <= 0.2)) out.push_back("alpha must be in (0, 0.2]");
+  if (!(margin >= 0.0) || !(law_margin >= 0.0)) out.push_back("margins must be >= 0");
   for (const auto& c : candidates) {
     bool known = false;
     for (const auto& k : ringdownExtensionNames()) known |= k == c;
@@ -90,12 +91,54 @@ double ringdownLackOfFitP(const RingdownFit& fit) {
   if (qr.rank() < p + q) return 1.0;
   const Eigen::VectorXd b = qr.solve(r);
   const Eigen::VectorXd e = r - X * b;
-  const HacCovariance hac = hacCovariance(X, e, -1);
+  const RingdownCovariance cov = ringdownCovariance(X, e);
   const Eigen::VectorXd bq = b.tail(q);
-  const Eigen::MatrixXd C = hac.covariance.bottomRightCorner(q, q);
+  const Eigen::MatrixXd C = cov.covariance.bottomRightCorner(q, q);
   const double w = bq.dot(C.colPivHouseholderQr().solve(bq));
   return chi2Upper(q, w);
 }
+
+namespace {
+
+/// Blocked two-fold hold-out error of a model: the span's used samples in kHoldOutBlocks
+/// contiguous blocks, fitted on the even blocks and scored on the odd ones and back, started from
+/// the full fit. Returns the weighted squared prediction error over all samples (inf on failure).
+constexpr int kHoldOutBlocks = 16;
+double holdOutError(const RingdownEnvelope& env, const RingdownSegment& seg,
+                    const RingdownFit& full, const RingdownFitOptions& base) {
+  std::vector<size_t> used;
+  for (size_t i = seg.i_start; i < seg.i_end; ++i)
+    if (!seg.dropout[i] && std::isfinite(env.log_amplitude[i])) used.push_back(i);
+  const size_t n = used.size();
+  if (n != full.t_s.size() || n < 4 * kHoldOutBlocks) return kInfinity;
+  double err = 0.0;
+  for (int fold = 0; fold < 2; ++fold) {
+    RingdownFitOptions o = base;
+    o.details = false;
+    o.hold_out.assign(env.size(), false);
+    for (size_t k = 0; k < n; ++k)
+      o.hold_out[used[k]] = static_cast<int>(k * kHoldOutBlocks / n) % 2 != fold;
+    RingdownFit f;
+    try {
+      f = fitRingdown(env, seg, full.model, o, {full.p});
+    } catch (const AnalysisError&) {
+      return kInfinity;
+    }
+    for (size_t k = 0; k < n; ++k) {
+      if (!o.hold_out[used[k]]) continue;
+      const double e = full.log_amplitude[k] - ringdownPredict(f, full.t_s[k]);
+      if (!std::isfinite(e)) return kInfinity;
+      err += full.weight[k] * e * e;
+    }
+  }
+  return err;
+}
+
+bool isAmplitudeLaw(const std::string& c) {
+  return c == "gamma_nl" || c == "gamma_a";
+}
+
+}  // namespace
 
 RingdownExplanation explainRingdown(const RingdownEnvelope& env,
                                     const RingdownExplainOptions& options) {
@@ -105,64 +148,126 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
   x.segment = segmentRingdown(env, options.segmentation);
   x.baseline = fitRingdown(env, x.segment, "linear", options.fit);
   x.final_fit = x.baseline;
-  const double alpha_each = options.alpha / std::max<size_t>(1, options.candidates.size());
-  const RingdownStep* best = nullptr;
-  std::vector<RingdownFit> fits;
-  fits.reserve(options.candidates.size());
-  std::string negative_law;
-  for (const auto& c : options.candidates) {
-    RingdownStep s;
-    s.added = c;
+  const int nc = static_cast<int>(options.candidates.size());
+  std::vector<RingdownFit> fits(nc);
+  std::vector<bool> ok(nc, false);
+  // The effective sample size: n over the long-run variance factor of the best-fitting model's
+  // residuals (those closest to the noise), common to every criterion below.
+  double best_sse = x.baseline.sse_w, factor = x.baseline.long_run_factor;
+  for (int k = 0; k < nc; ++k) {
+    const std::string& c = options.candidates[k];
     try {
-      fits.push_back(fitRingdown(env, x.segment, c, options.fit, ringdownStarts(c, x.baseline)));
+      fits[k] = fitRingdown(env, x.segment, c, options.fit, ringdownStarts(c, x.baseline));
+      ok[k] = std::isfinite(fits[k].sse_w);
     } catch (const AnalysisError& e) {
+      RingdownStep s;
+      s.added = c;
       s.note = std::string("fit failed: ") + e.what();
       x.steps.push_back(s);
-      fits.emplace_back();
       continue;
     }
-    const RingdownFit& f = fits.back();
-    // Variance inflation of the extended fit's residuals (HAC / iid), >= 1.
-    const double infl = std::max(
-        1.0, f.cov_crb.trace() > 0
-                 ? f.cov_hac.diagonal().cwiseQuotient(f.cov_crb.diagonal().cwiseMax(1e-300)).mean()
-                 : 1.0);
-    s.n_eff = f.n / infl;
+    if (fits[k].sse_w < best_sse) best_sse = fits[k].sse_w, factor = fits[k].long_run_factor;
+  }
+  const double n = x.baseline.n;
+  const double n_eff = std::max(8.0, n / std::max(1.0, factor));
+  // Information criterion (BIC on the effective sample size): IC = n_eff ln(SSE / n) + k
+  // ln(n_eff); the beat also pays for the searched split frequency (~n/4 candidates).
+  auto ic = [&](const RingdownFit& f) {
+    double pen = f.n_params * std::log(n_eff);
+    if (f.model == "beat") pen += 2.0 * std::log(std::max(2.0, n / 4.0));
+    return n_eff * std::log(std::max(f.sse_w, 1e-300) / n) + pen;
+  };
+  const double ic_lin = ic(x.baseline);
+  x.information_criterion["linear"] = ic_lin;
+  std::vector<RingdownStep> steps(nc);
+  double ic_law = kInfinity, ic_negative_law = kInfinity;
+  std::string negative_law;
+  for (int k = 0; k < nc; ++k) {
+    if (!ok[k]) continue;
+    const RingdownFit& f = fits[k];
+    RingdownStep& s = steps[k];
+    s.added = options.candidates[k];
+    s.n_eff = n_eff;
     s.sigma = f.sigma;
     s.sigma_ratio = x.baseline.sigma / std::max(f.sigma, 1e-300);
     s.lr_statistic =
-        s.n_eff * std::log(std::max(x.baseline.sse_w, 1e-300) / std::max(f.sse_w, 1e-300));
-    const int df = f.n_params - 2;
-    double a = alpha_each;
-    if (c == "beat") a /= std::max(1.0, f.n / 4.0);  // the split was searched over ~n/4 frequencies
-    s.threshold = chi2Quantile(df, a);
-    s.p_value = chi2Upper(df, s.lr_statistic);
-    s.significant = s.lr_statistic > s.threshold;
+        n_eff * std::log(std::max(x.baseline.sse_w, 1e-300) / std::max(f.sse_w, 1e-300));
+    s.information_criterion = ic(f);
+    s.threshold = s.information_criterion - ic_lin + s.lr_statistic + options.margin;
+    s.p_value = chi2Upper(f.n_params - 2, s.lr_statistic);
+    s.significant = ic_lin - s.information_criterion > options.margin;
     s.note = signCheck(f);
     s.physical = s.note.empty();
-    s.accepted = s.significant && s.physical;
-    if (s.significant && !s.physical && (c == "gamma_nl" || c == "gamma_a") && f.p(2) < 0.0)
-      negative_law = c;
-    if (!s.significant && s.note.empty()) s.note = "not significant";
-    x.steps.push_back(s);
+    x.information_criterion[s.added] = s.information_criterion;
+    if (isAmplitudeLaw(s.added)) {
+      if (s.physical)
+        ic_law = std::min(ic_law, s.information_criterion);
+      else if (f.p(2) < 0.0 && s.information_criterion < ic_negative_law)
+        ic_negative_law = s.information_criterion, negative_law = s.added;
+    }
   }
-  size_t best_k = 0;
-  for (size_t k = 0; k < x.steps.size(); ++k)
-    if (x.steps[k].accepted && (!best || x.steps[k].lr_statistic > best->lr_statistic))
-      best = &x.steps[k], best_k = k;
-  if (best) {
-    x.selected.push_back(best->added);
-    x.final_fit = fits[best_k];
+  // Ranking: a beat or a two-stage decay must beat every physical amplitude law by the margin
+  // beyond its extra parameters; then the lowest criterion among the significant physical ones.
+  int best = -1;
+  for (int k = 0; k < nc; ++k) {
+    RingdownStep& s = steps[k];
+    if (!ok[k]) continue;
+    if (!s.significant || !s.physical) {
+      if (s.note.empty()) s.note = "criterion not below the single exponential's by the margin";
+      continue;
+    }
+    if (!isAmplitudeLaw(s.added) && ic_law - s.information_criterion < options.law_margin) {
+      s.note = "does not beat the amplitude-dependent damping laws by the margin";
+      continue;
+    }
+    if (best < 0 || s.information_criterion < steps[best].information_criterion) best = k;
   }
+  // Hold-out confirmation of the pick against the single exponential (and, for a beat or a
+  // two-stage decay, against the best physical amplitude law).
+  if (best >= 0) {
+    RingdownStep& s = steps[best];
+    s.hold_out_error = holdOutError(env, x.segment, fits[best], options.fit);
+    const double cv_lin = holdOutError(env, x.segment, x.baseline, options.fit);
+    double cv_rival = cv_lin;
+    if (!isAmplitudeLaw(s.added))
+      for (int k = 0; k < nc; ++k)
+        if (ok[k] && isAmplitudeLaw(steps[k].added) && steps[k].physical && steps[k].significant)
+          cv_rival = std::min(cv_rival, holdOutError(env, x.segment, fits[k], options.fit));
+    s.hold_out_reference = cv_rival;
+    if (!(s.hold_out_error < cv_rival)) {
+      s.note = "not confirmed on hold-out (blocked two-fold prediction error " +
+               fmt(s.hold_out_error) + " vs " + fmt(cv_rival) + ")";
+      best = -1;
+    } else {
+      s.accepted = true;
+    }
+  }
+  for (int k = 0; k < nc; ++k)
+    if (ok[k]) x.steps.push_back(steps[k]);
+  const RingdownStep* pick = nullptr;
+  if (best >= 0) {
+    x.selected.push_back(steps[best].added);
+    x.final_fit = fits[best];
+    for (const auto& s : x.steps)
+      if (s.accepted) pick = &s;
+  }
+  // An amplitude law that fits only with a negative coefficient and beats every physical
+  // candidate: the decay accelerates as it falls (no damping law does that).
+  double ic_best_physical = ic_lin;
+  for (int k = 0; k < nc; ++k)
+    if (ok[k] && steps[k].physical)
+      ic_best_physical = std::min(ic_best_physical, steps[k].information_criterion);
+  if (!(ic_best_physical - ic_negative_law > options.margin)) negative_law.clear();
   x.lack_of_fit_p = ringdownLackOfFitP(x.final_fit);
   x.lack_of_fit_test =
-      "HAC Wald test of Legendre P2..P5 in time added to the final model's weighted residuals";
+      "Wald test of Legendre P2..P5 in time added to the final model's weighted residuals, "
+      "covariance under the residuals' AR noise model";
   const bool lof = x.lack_of_fit_p < options.alpha;
-  x.unexplained = lof || (!best && !negative_law.empty());
+  x.unexplained = lof || (!pick && !negative_law.empty());
   bool negative = false;
   for (const auto& fl : x.final_fit.flags) negative |= fl.rfind("negative", 0) == 0;
   x.adequate = !x.unexplained && !negative;
-
+  const RingdownStep* best_step = pick;
   // Causes and the sentence.
   std::ostringstream cs;
   const auto& fin = x.final_fit;
@@ -182,7 +287,8 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     x.causes.push_back("drop_outs");
     cs << x.segment.n_dropouts_in_span << " drop-outs in the decay were left out. ";
   }
-  if (best) {
+  if (best_step) {
+    const RingdownStep* best = best_step;
     x.causes.push_back(best->added);
     if (best->added == "gamma_nl")
       cs << "Damping grows with the amplitude squared (gas or thermoelastic-like loss): Q0 = "
@@ -212,7 +318,7 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
        << ": drift of the mode out of the detection band or loss of detection; this Q is not "
           "reliable. ";
   }
-  if (!best && !x.unexplained)
+  if (!best_step && !x.unexplained)
     cs << "A single exponential decay explains the envelope: Q = " << qtext("Q") << ". ";
   if (negative) cs << "A fitted damping is negative: not an adequate model. ";
   x.cause = cs.str();

@@ -7,7 +7,7 @@
 #include <limits>
 #include <sstream>
 
-#include "cvg_bench/core/estimate/hac_covariance.h"
+#include "cvg_bench/core/estimate/ringdown_intervals.h"
 #include "cvg_bench/core/estimate/ringdown_models.h"
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/errors.h"
@@ -66,7 +66,7 @@ bool levenbergMarquardt(const std::string& model, Eigen::VectorXd& p, const Data
   sse = r.squaredNorm();
   double lambda = 1e-3;
   Eigen::MatrixXd J;
-  for (int it = 0; it < 200; ++it) {
+  for (int it = 0; it < 100; ++it) {
     if (!jacobian(model, p, d, floor_rel, J)) return false;
     const Eigen::VectorXd dscale = J.colwise().norm().cwiseMax(1e-12);
     bool improved = false;
@@ -87,7 +87,8 @@ bool levenbergMarquardt(const std::string& model, Eigen::VectorXd& p, const Data
         sse = rn.squaredNorm();
         lambda = std::max(lambda / 5.0, 1e-12);
         improved = true;
-        if (rel < 1e-12 || step.norm() < 1e-12 * (1.0 + p.norm())) return true;
+        // A relative decrease of 1e-10 moves the estimate by ~1e-5 sqrt(n) of its standard error.
+        if (rel < 1e-10 || step.norm() < 1e-12 * (1.0 + p.norm())) return true;
       } else {
         lambda *= 8.0;
       }
@@ -172,33 +173,40 @@ std::vector<Eigen::VectorXd> ringdownStarts(const std::string& model, const Ring
     }
   } else if (model == "beat") {
     // Residual periodogram of the linear fit: peaks between 1.5 cycles per span and a quarter of
-    // the sample rate give the split w; the modulation depth m gives A2/A1 ~ m.
+    // the sample rate (at most 256 cycles per span) give the split w; the modulation depth m
+    // gives A2/A1 ~ m. The residuals are averaged into at most 1024 equal time bins first.
     const int n = static_cast<int>(lin.t_s.size());
-    std::vector<double> tt(n), rr(n);
+    const int nb = std::min(n, 1024);
+    std::vector<double> tt(nb, 0.0), rr(nb, 0.0);
+    std::vector<int> cnt(nb, 0);
     for (int i = 0; i < n; ++i) {
-      tt[i] = (lin.t_s[i] - lin.t_ref_s) / lin.t_scale_s;
-      rr[i] = lin.log_amplitude[i] - lin.fitted[i];
+      const double tn = (lin.t_s[i] - lin.t_ref_s) / lin.t_scale_s;
+      const int b = std::min(nb - 1, std::max(0, static_cast<int>(tn * nb)));
+      tt[b] += tn, rr[b] += lin.log_amplitude[i] - lin.fitted[i], ++cnt[b];
     }
-    const double w_max = M_PI * n / 2.0;
+    int m_used = 0;
+    for (int b = 0; b < nb; ++b)
+      if (cnt[b] > 0) tt[m_used] = tt[b] / cnt[b], rr[m_used] = rr[b] / cnt[b], ++m_used;
+    tt.resize(m_used), rr.resize(m_used);
+    const double w_max = M_PI * m_used / 2.0;
     std::vector<std::pair<double, double>> peaks;  // power, w
     double prev2 = 0, prev1 = 0, w_prev = 0;
     const double dw = M_PI / 4.0;
     for (double w = 1.5 * 2 * M_PI; w < w_max; w += dw) {
       double c = 0, sn = 0;
-      for (int i = 0; i < n; ++i)
+      for (int i = 0; i < m_used; ++i)
         c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
       const double pw = c * c + sn * sn;
       if (prev1 > prev2 && prev1 >= pw) peaks.emplace_back(prev1, w_prev);
       prev2 = prev1, prev1 = pw, w_prev = w;
-      if (peaks.size() > 400) break;
     }
     std::sort(peaks.rbegin(), peaks.rend());
     for (size_t k = 0; k < std::min<size_t>(3, peaks.size()); ++k) {
       const double w = peaks[k].second;
       double c = 0, sn = 0;
-      for (int i = 0; i < n; ++i)
+      for (int i = 0; i < m_used; ++i)
         c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
-      const double m = std::min(0.9, std::max(1e-3, 2.0 * std::sqrt(c * c + sn * sn) / n));
+      const double m = std::min(0.9, std::max(1e-3, 2.0 * std::sqrt(c * c + sn * sn) / m_used));
       const double phi = std::atan2(-sn, c);
       Eigen::VectorXd p(6);
       p << a, g, a + std::log(m), g, w, phi;
@@ -227,18 +235,31 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
   std::vector<size_t> used;
   for (size_t i = seg.i_start; i < seg.i_end; ++i)
     if (!seg.dropout[i] && std::isfinite(env.log_amplitude[i])) used.push_back(i);
-  const int n = static_cast<int>(used.size());
-  if (n < static_cast<int>(fit.names.size()) + 4)
-    throw AnalysisError("ring-down: " + std::to_string(n) + " samples in the span for " +
+  if (used.size() < fit.names.size() + 4)
+    throw AnalysisError("ring-down: " + std::to_string(used.size()) + " samples in the span for " +
                         std::to_string(fit.names.size()) + " parameters of model " + model);
   fit.t_ref_s = env.t_s[used.front()];
   fit.t_scale_s = std::max(env.t_s[used.back()] - fit.t_ref_s, 1e-300);
   {
     std::vector<double> first;
-    for (int i = 0; i < std::min(n, 5); ++i) first.push_back(env.log_amplitude[used[i]]);
+    for (size_t i = 0; i < std::min<size_t>(used.size(), 5); ++i)
+      first.push_back(env.log_amplitude[used[i]]);
     fit.log_a_ref = median(first);
   }
   fit.floor_rel = seg.has_floor ? std::exp(seg.floor_log_amplitude - fit.log_a_ref) : 0.0;
+  if (!options.hold_out.empty()) {
+    if (options.hold_out.size() != env.size())
+      throw InputError("ring-down fit: hold_out has " + std::to_string(options.hold_out.size()) +
+                       " flags for " + std::to_string(env.size()) + " samples");
+    std::vector<size_t> kept;
+    for (size_t i : used)
+      if (!options.hold_out[i]) kept.push_back(i);
+    used.swap(kept);
+  }
+  const int n = static_cast<int>(used.size());
+  if (n < static_cast<int>(fit.names.size()) + 4)
+    throw AnalysisError("ring-down: " + std::to_string(n) + " samples fitted for " +
+                        std::to_string(fit.names.size()) + " parameters of model " + model);
   Data d;
   d.t.resize(n), d.y.resize(n), d.w.resize(n);
   for (int i = 0; i < n; ++i) {
@@ -321,7 +342,9 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
     if (model == "linear") {
       st.push_back(lin);
     } else {
-      RingdownFit base = fitRingdown(env, seg, "linear", options);
+      RingdownFitOptions lean = options;
+      lean.details = false;
+      RingdownFit base = fitRingdown(env, seg, "linear", lean);
       st = ringdownStarts(model, base);
     }
   }
@@ -353,43 +376,40 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
   fit.sse_w = best;
   Eigen::VectorXd r;
   residuals(model, fit.p, d, fit.floor_rel, r);
-  Eigen::MatrixXd J;
-  jacobian(model, fit.p, d, fit.floor_rel, J);
   const int p_n = static_cast<int>(fit.p.size());
   fit.n = n;
   fit.n_params = p_n;
-  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(J);
-  fit.rank = static_cast<int>(qr.rank());
   fit.sigma = std::sqrt(best / std::max(1, n - p_n));
   {
-    double s = 0, c0 = 0, c1 = 0;
-    for (int i = 0; i < n; ++i) {
-      const double e = r(i) / std::sqrt(d.w(i));
-      s += e * e;
-      c0 += r(i) * r(i);
-      if (i > 0) c1 += r(i) * r(i - 1);
-    }
+    double s = 0;
+    for (int i = 0; i < n; ++i) s += r(i) * r(i) / d.w(i);
     fit.rms_log = std::sqrt(s / n);
-    fit.rho1 = c0 > 0 ? c1 / c0 : 0.0;
   }
-  // CRB under white noise of the chosen model: sigma^2 (J'J)^-1 from R of the QR (pseudo-inverse).
-  {
-    const Eigen::MatrixXd Jp = J * qr.colsPermutation();
-    Eigen::HouseholderQR<Eigen::MatrixXd> hq(J);
-    Eigen::MatrixXd R = hq.matrixQR().topRows(p_n).triangularView<Eigen::Upper>();
-    Eigen::MatrixXd Rinv = Eigen::MatrixXd::Identity(p_n, p_n);
-    if (fit.rank == p_n)
-      Rinv = R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(p_n, p_n));
-    else
-      Rinv.setZero();
-    fit.cov_crb = fit.sigma * fit.sigma * Rinv * Rinv.transpose();
-    (void)Jp;
+  if (!options.details) {
+    for (int i = 0; i < n; ++i) {
+      fit.t_s.push_back(env.t_s[used[i]]);
+      fit.log_amplitude.push_back(env.log_amplitude[used[i]]);
+      fit.fitted.push_back(ringdownLogAmplitude(model, fit.p, d.t(i), fit.floor_rel) +
+                           fit.log_a_ref);
+      fit.weight.push_back(d.w(i));
+    }
+    return fit;
   }
-  const HacCovariance hac = hacCovariance(J, r, -1);
-  fit.cov_hac = hac.covariance;
-  fit.interval_method = hac.method + " of the weighted ln A residuals (" + fit.error_model +
-                        " error model); Cramer-Rao bound for white noise reported beside it";
-  const double z = studentQuantile(options.confidence, std::max(1, n - p_n));
+  // Intervals under the residuals' serial correlation (ringdown_intervals.h); the Cramer-Rao
+  // bound for white noise beside them.
+  Eigen::MatrixXd J;
+  jacobian(model, fit.p, d, fit.floor_rel, J);
+  const RingdownCovariance rc = ringdownCovariance(J, r);
+  fit.rank = rc.rank;
+  fit.rho1 = rc.rho1;
+  fit.cov_crb = rc.crb;
+  fit.cov_hac = rc.covariance;
+  fit.noise_ar_order = static_cast<int>(rc.ar.size());
+  fit.long_run_factor = rc.long_run_factor;
+  fit.effective_n = rc.effective_n;
+  fit.interval_method = rc.method + "; " + fit.error_model + " error model";
+  const double z = studentQuantile(
+      options.confidence, std::max(1, static_cast<int>(std::floor(fit.effective_n)) - p_n));
 
   // Physical values. Time scale T: rates in 1/T -> 1/s divide by T.
   const double T = fit.t_scale_s;
@@ -487,9 +507,10 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
       lvl /= m;
       const Eigen::VectorXd c = X.colPivHouseholderQr().solve(Y);
       const Eigen::VectorXd res = Y - X * c;
-      const HacCovariance hb = hacCovariance(X, res, -1);
+      const RingdownCovariance hb = ringdownCovariance(X, res);
       RingdownValue rate;
-      const double zb = studentQuantile(options.confidence, std::max(1, m - 2));
+      const double zb = studentQuantile(
+          options.confidence, std::max(1, static_cast<int>(std::floor(hb.effective_n)) - 2));
       rate.value = c(1) / ts;  // in 1/T
       rate.std = std::sqrt(std::max(0.0, hb.covariance(1, 1))) / ts;
       rate.ci_low = rate.value - zb * rate.std, rate.ci_high = rate.value + zb * rate.std;
@@ -504,6 +525,12 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
     }
   }
   return fit;
+}
+
+double ringdownPredict(const RingdownFit& fit, double t_s) {
+  return ringdownLogAmplitude(fit.model, fit.p, (t_s - fit.t_ref_s) / fit.t_scale_s,
+                              fit.floor_rel) +
+         fit.log_a_ref;
 }
 
 }  // namespace cvg_bench

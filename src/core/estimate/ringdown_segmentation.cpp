@@ -12,6 +12,8 @@ namespace cvg_bench {
 namespace {
 
 constexpr double kDbPerNeper = 20.0 / 2.302585092994046;  // 20 / ln 10
+/// A floor: the tail lies this far above the decay's straight continuation [dB].
+constexpr double kFloorExcessDb = 5.0;
 
 double median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -103,45 +105,73 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     if (std::isfinite(sm[i])) idx.push_back(i);
   if (idx.size() < 8) throw AnalysisError("ring-down: fewer than 8 usable envelope samples");
 
-  // 2. Noise floor: last tenth flat compared with the overall decline.
+  // 2. Noise floor: the record's last tenth lies well above the straight continuation of the decay
+  // (fitted on the decay's last stretch above that tail level), which a pure decay does not.
   const size_t tail_a = n - std::max<size_t>(4, n / 10);
-  const double tail_slope =
-      slopeOver(t, sm, seg.dropout, tail_a, n);  // smoothed: log-Rayleigh noise
   double peak_sm = -std::numeric_limits<double>::infinity();
   size_t i_peak = 0;
   for (size_t i : idx)
     if (sm[i] > peak_sm) peak_sm = sm[i], i_peak = i;
-  const double overall_slope =
-      (sm[idx.back()] - peak_sm) / std::max(t[idx.back()] - t[i_peak], 1e-300);
-  // Floor: the tail is flat, and well below the peak (a plateau-only record is not a floor).
   size_t i_end = n;
   {
-    double pow_sum = 0.0;
-    size_t cnt = 0;
+    std::vector<double> tail;
     for (size_t i = tail_a; i < n; ++i)
-      if (!seg.dropout[i]) pow_sum += std::exp(2.0 * (y[i] - peak_sm)), ++cnt;
-    const double floor_log = cnt ? peak_sm + 0.5 * std::log(pow_sum / cnt) : peak_sm;
-    const bool flat =
-        overall_slope < 0.0 && std::fabs(tail_slope) < 0.25 * std::fabs(overall_slope);
-    if (flat &&
-        peak_sm - floor_log > (options.floor_margin_db + options.min_decay_db) / kDbPerNeper) {
-      seg.has_floor = true;
-      seg.floor_log_amplitude = floor_log;
-      const double cut = floor_log + options.floor_margin_db / kDbPerNeper;
-      // The span ends at the first smoothed sample after the peak at or below the cut.
-      i_end = n;
-      for (size_t i = i_peak; i < n; ++i)
-        if (std::isfinite(sm[i]) && sm[i] <= cut) {
-          i_end = i;
-          break;
+      if (std::isfinite(sm[i])) tail.push_back(sm[i]);
+    const double tail_level = tail.empty() ? peak_sm : median(tail);
+    const double total = peak_sm - tail_level;
+    // The decay's last stretch: from 25 dB (or 3/4 of the drop) to 10 dB (or 1/4) above the tail.
+    const double hi = tail_level + std::min(25.0 / kDbPerNeper, 0.75 * total);
+    const double lo = tail_level + std::min(10.0 / kDbPerNeper, 0.25 * total);
+    size_t a = n, b = n;
+    for (size_t i = i_peak; i < n; ++i) {
+      if (!std::isfinite(sm[i])) continue;
+      if (a == n && sm[i] <= hi) a = i;
+      if (sm[i] <= lo) {
+        b = i;
+        break;
+      }
+    }
+    const double excess_min = kFloorExcessDb / kDbPerNeper;
+    if (total > (options.floor_margin_db + options.min_decay_db) / kDbPerNeper && a < n && b < n &&
+        b > a + 4) {
+      const double slope = slopeOver(t, sm, seg.dropout, a, b);
+      double level_a = 0.0;  // the line through the stretch's mean
+      double t_mean = 0.0;
+      int cnt = 0;
+      for (size_t i = a; i < b; ++i)
+        if (!seg.dropout[i] && std::isfinite(sm[i])) level_a += sm[i], t_mean += t[i], ++cnt;
+      level_a /= std::max(1, cnt), t_mean /= std::max(1, cnt);
+      const double t_tail = 0.5 * (t[tail_a] + t.back());
+      const double extrapolated = level_a + slope * (t_tail - t_mean);
+      if (slope < 0.0 && tail_level - extrapolated > excess_min) {
+        // Floor power: the tail's mean power less the decay's continuation.
+        double pow_sum = 0.0;
+        size_t c = 0;
+        for (size_t i = tail_a; i < n; ++i) {
+          if (seg.dropout[i] || !std::isfinite(y[i])) continue;
+          const double line = level_a + slope * (t[i] - t_mean);
+          pow_sum += std::exp(2.0 * (y[i] - tail_level)) - std::exp(2.0 * (line - tail_level));
+          ++c;
         }
-      const double reach = floor_log + 3.0 / kDbPerNeper;
-      seg.floor_start_s = t.back();
-      for (size_t i = i_end; i < n; ++i)
-        if (std::isfinite(sm[i]) && sm[i] <= reach) {
-          seg.floor_start_s = t[i];
-          break;
-        }
+        const double floor_log =
+            tail_level + 0.5 * std::log(std::max(pow_sum / std::max<size_t>(1, c), 1e-6));
+        seg.has_floor = true;
+        seg.floor_log_amplitude = floor_log;
+        const double cut = floor_log + options.floor_margin_db / kDbPerNeper;
+        // The span ends at the first smoothed sample after the peak at or below the cut.
+        for (size_t i = i_peak; i < n; ++i)
+          if (std::isfinite(sm[i]) && sm[i] <= cut) {
+            i_end = i;
+            break;
+          }
+        const double reach = floor_log + 3.0 / kDbPerNeper;
+        seg.floor_start_s = t.back();
+        for (size_t i = i_end; i < n; ++i)
+          if (std::isfinite(sm[i]) && sm[i] <= reach) {
+            seg.floor_start_s = t[i];
+            break;
+          }
+      }
     }
   }
 

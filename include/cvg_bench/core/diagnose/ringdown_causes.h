@@ -6,14 +6,20 @@
 //  - noise_floor, drop_outs: from the segmentation;
 //  - unexplained: systematic structure no physical law removes (a rate that rises and falls, or an
 //    amplitude law with the wrong sign: detection loss, the mode drifting out of the band).
-// Test: likelihood ratio of the weighted fits with the sample count divided by the HAC variance
-// inflation of the extended fit (correlated residuals carry fewer independent samples), level
-// alpha Bonferroni over the candidates (the beat also over the searched frequencies); every fitted
-// damping must be positive and the amplitude law's coefficient positive (sign check), else the
-// extension is not accepted. The final model's lack of fit: HAC Wald test of Legendre polynomials
-// P2..P5 in time added to its residuals.
+// Selection: every candidate law is fitted; an information criterion (BIC with the effective
+// sample size n / c, c the long-run variance factor of the best-fitting model's residuals, so that
+// correlated residuals count as fewer samples; the beat also pays for its searched split) must lie
+// `margin` below the single exponential's; every fitted damping must be positive and an amplitude
+// law's coefficient positive (sign check), else the law is not physical; a beat or a two-stage
+// decay must also lie `law_margin` below every physical amplitude law (they can bend a decay the
+// same way with more parameters). The lowest criterion wins and is confirmed on hold-out (blocked
+// two-fold prediction error below the single exponential's and the rival law's). An amplitude law
+// with a negative coefficient that beats every physical model by the margin means the decay
+// accelerates as it falls: "unexplained". The final model's lack of fit: Wald test of Legendre
+// polynomials P2..P5 in time added to its residuals, covariance under the residuals' AR model.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -22,8 +28,12 @@
 namespace cvg_bench {
 
 struct RingdownExplainOptions {
-  /// Family-wise level of the extension tests and of the lack-of-fit test, (0, 0.2].
+  /// Level of the lack-of-fit test, (0, 0.2].
   double alpha = 0.001;
+  /// An extension's information criterion must lie this far below the single exponential's.
+  double margin = 10.0;
+  /// A beat or two-stage decay must lie this far below every physical amplitude law.
+  double law_margin = 10.0;
   /// Candidate extensions tried (ringdownExtensionNames() by default).
   std::vector<std::string> candidates = {"gamma_nl", "gamma_a", "beat", "two_stage"};
   RingdownFitOptions fit;
@@ -39,15 +49,19 @@ struct RingdownStep {
   double n_eff = 0.0;
   double p_value = 1.0;
   bool significant = false, physical = false, accepted = false;
-  std::string note;  ///< why not accepted / the sign check
+  std::string note;                    ///< why not accepted / the sign check
+  double information_criterion = 0.0;  ///< BIC on the effective sample size
+  double hold_out_error = 0.0;         ///< blocked two-fold prediction error (the pick only)
+  double hold_out_reference = 0.0;     ///< the same for the rival it had to beat
 };
 
 struct RingdownExplanation {
   RingdownSegment segment;
   RingdownFit baseline, final_fit;
   std::vector<RingdownStep> steps;
-  std::vector<std::string> selected;  ///< accepted extensions (at most one)
-  std::vector<std::string> causes;    ///< named findings (see the header comment)
+  std::vector<std::string> selected;                    ///< accepted extensions (at most one)
+  std::vector<std::string> causes;                      ///< named findings (see the header comment)
+  std::map<std::string, double> information_criterion;  ///< per model, "linear" included
   bool unexplained = false;
   bool adequate = false;  ///< final model fits, every damping positive
   std::string lack_of_fit_test;

@@ -7,11 +7,12 @@
 // is noise on the log/dB scale (relative noise); a growth as 1/A is additive noise on the amplitude
 // (with the floor). The weights are 1 / s^2 at each sample's fitted level either way.
 //
-// Intervals: HAC sandwich (hac_covariance.h: Newey-West, Bartlett weights, Andrews lag after VAR(1)
-// prewhitening) of the weighted residuals, which stays honest when the residuals are correlated
-// (detector filters, drift); the Cramer-Rao bound (white noise with the chosen error model:
-// sigma^2 (J'WJ)^-1) is reported beside it. Q = pi f tau (tau the amplitude time constant) with a
-// confidence interval mapped from that of the rate (asymmetric), std by the delta method.
+// Intervals: ringdown_intervals.h (serial correlation detected in the weighted ln A residuals ->
+// sandwich under an AR(p) noise model, else white), which stays honest when the residuals are
+// correlated (detector filters, drift); the Cramer-Rao bound (white noise with the chosen error
+// model: sigma^2 (J'WJ)^-1) is reported beside it. cov_hac holds the honest covariance. Q = pi f
+// tau (tau the amplitude time constant) with a confidence interval mapped from that of the rate
+// (asymmetric), std by the delta method.
 #pragma once
 
 #include <Eigen/Core>
@@ -31,6 +32,11 @@ struct RingdownFitOptions {
   std::string error_model = "auto";
   /// Q against amplitude: number of amplitude bins (0 = automatic, 3 dB or more each, <= 8).
   int q_bins = 0;
+  /// Per envelope sample: true = held out of the fit (hold-out checks). The normalization (t_ref,
+  /// t_scale, A_ref) still comes from the whole span, so parameters compare across folds.
+  std::vector<bool> hold_out;
+  /// false: parameters and residuals only (no covariance, no Q against amplitude).
+  bool details = true;
   std::vector<std::string> validate() const;
 };
 
@@ -59,10 +65,13 @@ struct RingdownFit {
   double floor_rel = 0.0;                 ///< floor amplitude / A_ref in the model (0: none)
   double frequency_hz = 0.0;
   int n = 0, n_params = 0, rank = 0;
-  double sse_w = 0.0;    ///< weighted residual sum of squares
-  double sigma = 0.0;    ///< rms of the weighted residuals (1 = the error model's scale)
-  double rms_log = 0.0;  ///< rms residual of ln A [Np]
-  double rho1 = 0.0;     ///< lag-1 autocorrelation of the residuals
+  double sse_w = 0.0;            ///< weighted residual sum of squares
+  double sigma = 0.0;            ///< rms of the weighted residuals (1 = the error model's scale)
+  double rms_log = 0.0;          ///< rms residual of ln A [Np]
+  double rho1 = 0.0;             ///< lag-1 autocorrelation of the residuals
+  int noise_ar_order = 0;        ///< AR order of the residual noise model (0: white)
+  double long_run_factor = 1.0;  ///< its long-run variance factor 1 + 2 sum rho_l
+  double effective_n = 0.0;      ///< n / long_run_factor
   bool converged = false;
   std::string error_model;  ///< "log" or "additive"
   std::string error_model_why;
@@ -81,6 +90,9 @@ struct RingdownFit {
 RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
                         const std::string& model, const RingdownFitOptions& options = {},
                         const std::vector<Eigen::VectorXd>& starts = {});
+
+/// ln A (file's unit) of a fitted model at time t [s] (any t, e.g. held-out samples).
+double ringdownPredict(const RingdownFit& fit, double t_s);
 
 /// Starting points for a model from a fitted linear baseline (residual periodogram for beat).
 std::vector<Eigen::VectorXd> ringdownStarts(const std::string& model, const RingdownFit& linear);

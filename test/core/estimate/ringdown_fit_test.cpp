@@ -72,11 +72,13 @@ TEST(RingdownFit, ScaleFreeAndDbInputGiveTheSameQ) {
 TEST(RingdownFit, ErrorModelIsChosenFromTheData) {
   RingdownSimulationOptions o = bench();
   o.noise_db = 0.3;
-  o.floor_db = -80.0;
+  o.floor_db = -400.0;  // no additive noise: relative noise only, 60 s = 9.4 tau of decay
+  o.duration_s = 60.0;
   o.dropouts = 0;
   EXPECT_EQ(fitOf(simulateRingdown(o)).error_model, "log");
   o.noise_db = 0.0;
   o.floor_db = -50.0;
+  o.duration_s = 0.0;
   EXPECT_EQ(fitOf(simulateRingdown(o)).error_model, "additive");
 }
 

@@ -1,0 +1,40 @@
+// Covariance of a ring-down envelope fit (ringdown_fit.h) under the correlated residuals real
+// records show (lock-in low-pass, source drift, spectrum-analyser video filter).
+//
+// 1. Detection: the lag-1 autocorrelation of the weighted ln A residuals against its white-noise
+//    band +- 2.576 / sqrt(n) (two-sided 1 %) and the Ljung-Box statistic over 10 lags (1 %).
+// 2. White residuals: the Cramer-Rao covariance sigma^2 (J'J)^-1 (R of the QR of J).
+// 3. Correlated residuals: an AR(p) noise model of the residuals (least squares by QR, p <= 12 by
+//    BIC), its autocovariance gamma_l from the Yule-Walker recursion, and the sandwich
+//    (J'J)^-1 (sum_{i,j} gamma_|i-j| J_i J_j') (J'J)^-1, the lag sum truncated where the model's
+//    autocorrelation falls below 1e-4; the variance is scaled so that gamma_0 is the residuals'
+//    variance. The effective sample size n / c (c = the long-run variance factor of the model) sets
+//    the Student quantile's degrees of freedom.
+// The Cramer-Rao bound for white noise (step 2) is returned beside it for the report.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace cvg_bench {
+
+struct RingdownCovariance {
+  Eigen::MatrixXd covariance;  ///< p x p, the honest one (equal to crb when white)
+  Eigen::MatrixXd crb;         ///< sigma^2 (J'J)^-1, white noise
+  bool correlated = false;
+  double rho1 = 0.0;             ///< lag-1 autocorrelation of the residuals
+  double ljung_box_p = 1.0;      ///< p-value of the Ljung-Box test over 10 lags
+  std::vector<double> ar;        ///< a_1..a_p of the noise model (empty: white)
+  double long_run_factor = 1.0;  ///< 1 + 2 sum rho_l of the noise model
+  double effective_n = 0.0;      ///< n / long_run_factor
+  int rank = 0;
+  std::string method;  ///< e.g. "AR(3) noise model of the weighted ln A residuals (...)"
+};
+
+/// jacobian: n x p of the weighted model, rows in time order; residuals: the n weighted residuals
+/// (sigma^2 = SSE / (n - p)).
+RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& jacobian,
+                                      const Eigen::VectorXd& residuals);
+
+}  // namespace cvg_bench
