@@ -161,6 +161,15 @@ target("RLS block update, 13 params", "BM_RlsBlockUpdate13Params",
        lambda b: seconds(b) * 1e6, "%.2f us", lambda v: v <= 2.0, "<= 2 us")
 lines += ["## Targets of the issues (this run)", "",
           "| what | measured | target | |", "|---|---|---|---|"] + targets + [""]
+# Sections appended by other measurements (e.g. "## Live bench under load" of the ROS load
+# test) are not produced here: carry them over from the previous file.
+try:
+    previous = open(md_path).read().split("\n")
+except OSError:
+    previous = []
+kept = next((i for i, l in enumerate(previous) if l.startswith("## Live")), None)
+if kept is not None:
+    lines += previous[kept:]
 open(md_path, "w").write("\n".join(lines))
 print("run_benchmarks: wrote", md_path)
 PY
