@@ -23,9 +23,9 @@ void stage(const ResonatorModel& model, const Eigen::VectorXd& z, double t,
   const SlowContext ctx{t, 0.0};
   model.regressor(q, ctx, *d);
   const int p = model.numParameters();
-  *k = 0.5 * (*d * z);
+  *k = 0.5 * d->lazyProduct(z);
   const Eigen::Matrix4d a = model.slowJacobian(q, ctx, z);
-  ks->noalias() = a * s;
+  ks->noalias() = a.lazyProduct(s);  // coefficient-based: 4 x 4 times 4 x (k + 4)
   ks->leftCols(p) += 0.5 * *d;
 }
 
