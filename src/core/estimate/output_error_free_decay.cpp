@@ -25,7 +25,8 @@ void stage(const ResonatorModel& model, const Eigen::VectorXd& z, double t,
   const int p = model.numParameters();
   *k = 0.5 * d->lazyProduct(z);
   const Eigen::Matrix4d a = model.slowJacobian(q, ctx, z);
-  ks->noalias() = a.lazyProduct(s);  // coefficient-based: 4 x 4 times 4 x (k + 4)
+  // Column by column: fixed-size 4 x 4 times 4-vector products (vectorized, no GEMM dispatch).
+  for (Eigen::Index j = 0; j < s.cols(); ++j) ks->col(j).noalias() = a * s.col(j);
   ks->leftCols(p) += 0.5 * *d;
 }
 
