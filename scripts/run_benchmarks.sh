@@ -35,7 +35,7 @@ echo "run_benchmarks: scripts/bench_explain_scaling.py --sizes $sizes"
 }
 /usr/bin/python3 - "$out/cpp.json" "$out/numpy.jsonl" "$root/docs/benchmarks.md" "$reps" \
   "$out/scaling.jsonl" <<'PY'
-import datetime, json, subprocess, sys
+import datetime, json, os, subprocess, sys
 
 cpp_path, numpy_path, md_path, REPS, scaling_path = sys.argv[1:6]
 cpp = json.load(open(cpp_path))
@@ -72,6 +72,9 @@ lines = [
     % ctx.get("library_build_type", "?"),
     "- Each C++ figure is the median of %s repetitions; cv = their coefficient of variation"
     % REPS,
+    "- Load average when the table was written: %.1f (1 min) on %s CPU(s); a shared machine "
+    "slows every figure, so compare figures of the same run (ratios), not across runs"
+    % (os.getloadavg()[0], lscpu("CPU(s)")),
     "- NumPy references: scripts/bench_numpy_*.py run in the same session (/usr/bin/python3, "
     "numpy %s), matched by name" % subprocess.run(
         ["/usr/bin/python3", "-c", "import numpy; print(numpy.__version__)"],
@@ -121,13 +124,25 @@ scaling = [json.loads(l) for l in open(scaling_path) if l.startswith("{")]
 if scaling:
     lines += ["## explain and Ceres identify against record length", "",
               "scripts/bench_explain_scaling.py: hrg_hemispherical free decay with xi hidden, one run "
-              "each (whole process: reading, fitting, printing), CPU time and peak resident memory.",
-              "", "| command | slow samples | exit | CPU time | peak RSS | RSS per sample |",
-              "|---|---|---|---|---|---|"]
+              "each (whole process: reading, fitting, printing); CPU time = user + system and peak "
+              "resident memory from the child's rusage (wait4). The RSS includes ~25 MB of "
+              "libraries; the growth per sample is the RSS difference to the next smaller record "
+              "divided by the samples added. Add 10^6 with CVG_BENCH_SCALING_SIZES=...,1000000 "
+              "(explain takes ~3 min CPU there).",
+              "", "| command | slow samples | exit | CPU time | peak RSS | RSS per sample | "
+              "RSS growth per added sample |", "|---|---|---|---|---|---|---|"]
+    previous = {}
     for r in scaling:
-        lines.append("| %s | %d | %d | %.2f s | %.0f MB | %.0f B |" % (
-            r["name"].split("/")[0], r["samples"], r["exit"], r["cpu_s"],
-            r["peak_rss_bytes"] / 1e6, r["bytes_per_sample"]))
+        command = r["name"].split("/")[0]
+        growth = ""
+        if command in previous and r["samples"] > previous[command]["samples"]:
+            p = previous[command]
+            growth = "%.0f B" % ((r["peak_rss_bytes"] - p["peak_rss_bytes"]) /
+                                 (r["samples"] - p["samples"]))
+        previous[command] = r
+        lines.append("| %s | %d | %d | %.2f s | %.0f MB | %.0f B | %s |" % (
+            command, r["samples"], r["exit"], r["cpu_s"],
+            r["peak_rss_bytes"] / 1e6, r["bytes_per_sample"], growth))
     lines.append("")
 
 # The issues' targets against this run (medians).
@@ -161,6 +176,15 @@ target("RLS block update, 13 params", "BM_RlsBlockUpdate13Params",
        lambda b: seconds(b) * 1e6, "%.2f us", lambda v: v <= 2.0, "<= 2 us")
 lines += ["## Targets of the issues (this run)", "",
           "| what | measured | target | |", "|---|---|---|---|"] + targets + [""]
+# Sections appended by other measurements (e.g. "## Live bench under load" of the ROS load
+# test) are not produced here: carry them over from the previous file.
+try:
+    previous = open(md_path).read().split("\n")
+except OSError:
+    previous = []
+kept = next((i for i, l in enumerate(previous) if l.startswith("## Live")), None)
+if kept is not None:
+    lines += previous[kept:]
 open(md_path, "w").write("\n".join(lines))
 print("run_benchmarks: wrote", md_path)
 PY

@@ -6,7 +6,9 @@
 #include <limits>
 
 #include "cvg_bench/core/demod/demodulator_noise.h"
+#include "cvg_bench/core/estimate/free_decay_regression.h"
 #include "cvg_bench/core/estimate/identify_pipeline.h"
+#include "cvg_bench/core/estimate/least_squares_solver.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_model.h"
@@ -46,8 +48,7 @@ NestedFit residualsOnly(const StackedSystem& sys, const std::vector<std::string>
   f.model = sys.model;
   const Eigen::VectorXd norms = sys.d.colwise().norm().transpose().cwiseMax(1e-300);
   const Eigen::MatrixXd scaled = sys.d * norms.cwiseInverse().asDiagonal();
-  const Eigen::VectorXd z =
-      scaled.colPivHouseholderQr().solve(sys.y).cwiseQuotient(norms);
+  const Eigen::VectorXd z = scaled.colPivHouseholderQr().solve(sys.y).cwiseQuotient(norms);
   f.residuals = sys.y - sys.d * z;
   f.rss = f.residuals.squaredNorm();
   f.n_equations = static_cast<long>(sys.y.size());
@@ -77,6 +78,71 @@ NestedFit fitRecord(const SweepRecord& record, const IdentificationOptions& o,
   return f;
 }
 
+/// The triangular factor [R c; 0 rho] of the stacked equation-error system [D | y] of (2.8) for a
+/// model holding every extension of the subsets to rank, folded block by block (IncrementalQr,
+/// ~10 kB). Every nested model's columns are columns of D (each term adds its own columns), so its
+/// LS fit is the small problem min |c - R_S z|^2 + rho^2: the same solution and residual sum as
+/// the stacked one, solved the same way (column-equilibrated pivoted QR; the column norms of R_S
+/// are those of D_S).
+class EquationErrorFactor {
+ public:
+  const std::vector<std::string>& extensions() const { return extensions_; }
+  void clear() {
+    extensions_.clear();
+    names_.clear();
+    r_aug_.resize(0, 0);
+  }
+  bool covers(const ResonatorModel& model) const {
+    if (r_aug_.size() == 0) return false;
+    for (const auto& n : model.parameterNames())
+      if (std::find(names_.begin(), names_.end(), n) == names_.end()) return false;
+    return true;
+  }
+  void build(const ResonatorModel& model, const SlowRecord& record, double tolerance) {
+    clear();
+    IncrementalQr qr(model.numParameters());
+    forEachFreeDecayBlock(model, record, tolerance,
+                          [&](const RegressionBlock& b) { qr.addBlock(*b.d, b.y); });
+    rows_ = qr.numRows();
+    if (rows_ <= model.numParameters()) return;
+    r_aug_ = qr.rAug();
+    extensions_ = model.extensionNames();
+    names_ = model.parameterNames();
+  }
+  NestedFit solve(const ResonatorModel& model, const std::vector<std::string>& extensions) const {
+    const int k_all = static_cast<int>(names_.size());
+    const int k = model.numParameters();
+    Eigen::MatrixXd a(k_all, k);
+    for (int j = 0; j < k; ++j) {
+      const auto it = std::find(names_.begin(), names_.end(), model.parameterNames()[j]);
+      a.col(j) = r_aug_.col(it - names_.begin()).head(k_all);
+    }
+    const Eigen::VectorXd c = r_aug_.col(k_all).head(k_all);
+    const Eigen::VectorXd norms = a.colwise().norm().transpose().cwiseMax(1e-300);
+    const Eigen::MatrixXd scaled = a * norms.cwiseInverse().asDiagonal();
+    const Eigen::VectorXd z = scaled.colPivHouseholderQr().solve(c).cwiseQuotient(norms);
+    NestedFit f;
+    f.extensions = extensions;
+    f.model = model.spec();
+    f.rss = (c - a * z).squaredNorm() + r_aug_(k_all, k_all) * r_aug_(k_all, k_all);
+    f.n_equations = rows_;
+    const long dof = std::max<long>(1, f.n_equations - k);
+    f.sigma = std::sqrt(f.rss / static_cast<double>(dof));
+    f.estimate.model = model.spec();
+    f.estimate.method = "ls";
+    f.estimate.names = model.parameterNames();
+    f.estimate.values = z;
+    f.estimate.n_params = k;
+    f.estimate.sigma = f.sigma;
+    return f;
+  }
+
+ private:
+  std::vector<std::string> extensions_, names_;
+  Eigen::MatrixXd r_aug_;
+  long rows_ = 0;
+};
+
 class FreeDecayFitter : public NestedModelFitter {
  public:
   FreeDecayFitter(const SlowRecord& record, const NestedFitterOptions& options)
@@ -88,10 +154,41 @@ class FreeDecayFitter : public NestedModelFitter {
     return fitOn(record_, extensions);
   }
 
+  /// Every subset is solved from the triangular factor of the widest system seen so far (one
+  /// pass over the record per widening, see EquationErrorFactor); the per-equation residuals are
+  /// made (one more pass) only for a fit that is not a strict subset of an earlier successful one:
+  /// the subset search reads those of the linear model and of the widest fit, the rest need only
+  /// the residual sum.
   NestedFit fitEquationError(const std::vector<std::string>& extensions) const override {
-    IdentificationOptions o = options_.identification;
-    o.model = ResonatorModel(extensions, ExperimentMode::kFreeDecay).spec();
-    return residualsOnly(buildFreeDecaySystem({record_}, o), extensions);
+    const ResonatorModel model(extensions, ExperimentMode::kFreeDecay);
+    NestedFit f;
+    if (!factor_.covers(model)) {
+      std::vector<std::string> wider = factor_.extensions();
+      for (const auto& e : extensions)
+        if (std::find(wider.begin(), wider.end(), e) == wider.end()) wider.push_back(e);
+      try {
+        factor_.build(ResonatorModel(wider, ExperimentMode::kFreeDecay), record_,
+                      options_.identification.uniform_time_tolerance);
+      } catch (const InputError&) {
+        factor_.clear();
+      }
+    }
+    bool need_residuals = true;
+    for (const auto& done : fitted_cheap_)
+      if (strictSubset(extensions, done)) need_residuals = false;
+    if (factor_.covers(model)) {
+      f = factor_.solve(model, extensions);
+      if (need_residuals) {
+        f.residuals = equationResidualsStreamed(model, f.estimate.values);
+      }
+    } else {
+      IdentificationOptions o = options_.identification;
+      o.model = model.spec();
+      f = residualsOnly(buildFreeDecaySystem({record_}, o), extensions);
+      if (!need_residuals) f.residuals.resize(0);
+    }
+    fitted_cheap_.push_back(extensions);
+    return f;
   }
   bool refinesByOutputError() const override { return true; }
   std::vector<double> knownNoiseCorrelation() const override {
@@ -144,34 +241,28 @@ class FreeDecayFitter : public NestedModelFitter {
       values[fit.estimate.names[i]] = fit.estimate.values[i];
     const Eigen::VectorXd z = model.parameterVector(values);
     const size_t n = record_.size();
-    // The initial state q(t0) at the fitted z by Gauss-Newton (4 unknowns, central differences):
-    // the nuisance part of the output-error fit, so that the residuals are the noise alone.
+    // The initial state q(t0) at the fitted z by Gauss-Newton (4 unknowns, Jacobian -dq/dq(t0)
+    // by forward sensitivities, folded sample by sample into a 5 x 5 factor): the nuisance part
+    // of the output-error fit, so that the residuals are the noise alone.
     Eigen::Vector4d q0 = record_.q.front();
-    auto residual = [&](const Eigen::Vector4d& start, Eigen::VectorXd* r) {
-      std::vector<Eigen::Vector4d> traj;
-      if (!integrateSlowTrajectory(model, z, start, record_.t_s, options_.rk4_substeps, &traj) ||
-          traj.size() != n)
-        return false;
-      r->resize(4 * n);
-      for (size_t i = 0; i < n; ++i) r->segment<4>(4 * i) = record_.q[i] - traj[i];
-      return true;
-    };
-    Eigen::VectorXd r0, rp, rm;
-    for (int iter = 0; iter < 4 && residual(q0, &r0); ++iter) {
-      Eigen::MatrixXd jac(4 * n, 4);
-      const double h = 1e-6 * std::max(q0.norm(), 1e-12);
-      bool ok = true;
-      for (int c = 0; c < 4 && ok; ++c) {
-        Eigen::Vector4d qp = q0, qm = q0;
-        qp[c] += h;
-        qm[c] -= h;
-        ok = residual(qp, &rp) && residual(qm, &rm);
-        if (ok) jac.col(c) = (rp - rm) / (2 * h);
-      }
+    for (int iter = 0; iter < 4; ++iter) {
+      IncrementalQr qr(4);
+      RegressionBlockMatrix minus_s(4, 4);
+      const bool ok = integrateSlowInitialSensitivity(
+          model, z, q0, record_.t_s, options_.rk4_substeps,
+          [&](size_t i, const Eigen::Vector4d& q, const Eigen::Matrix4d& s) {
+            minus_s = -s;
+            qr.addBlock(minus_s, record_.q[i] - q);
+          });
       if (!ok) break;
-      q0 -= jac.colPivHouseholderQr().solve(r0);
+      const Eigen::MatrixXd& r_aug = qr.rAug();
+      q0 -= r_aug.topLeftCorner(4, 4).colPivHouseholderQr().solve(r_aug.col(4).head(4));
     }
-    if (!residual(q0, &r0)) r0 = Eigen::VectorXd::Zero(4 * n);
+    Eigen::VectorXd r0 = Eigen::VectorXd::Zero(4 * n);
+    std::vector<Eigen::Vector4d> traj;
+    if (integrateSlowTrajectory(model, z, q0, record_.t_s, options_.rk4_substeps, &traj) &&
+        traj.size() == n)
+      for (size_t i = 0; i < n; ++i) r0.segment<4>(4 * i) = record_.q[i] - traj[i];
     std::vector<double> t(n);
     for (size_t i = 0; i < n; ++i) t[i] = record_.t_s[i] - record_.t_s.front();
     return blockResiduals(r0, record_.q, t, {});
@@ -192,10 +283,13 @@ class FreeDecayFitter : public NestedModelFitter {
     p.ceres.rk4_substeps = options_.rk4_substeps;
     // A failed refinement keeps the LS answer (honest sandwich intervals) and says why.
     p.on_ceres_failure = CeresFailure::kKeepStart;
-    const StackedSystem sys = buildFreeDecaySystem({record}, p.identification);
-    NestedFit f = fitSystem(sys, p.identification, extensions);
+    NestedFit f;
+    f.extensions = extensions;
     f.estimate = identify(record, p);
-    f.residuals = equationResiduals(sys, f.estimate.values);
+    f.model = f.estimate.model;
+    const ResonatorModel model(extensions, ExperimentMode::kFreeDecay);
+    f.residuals = equationResidualsStreamed(model, f.estimate.values, record);
+    f.n_equations = static_cast<long>(f.residuals.size());
     f.sigma = f.estimate.sigma;
     if (f.estimate.method != methodName(Method::kCeres)) {
       f.rss = f.residuals.squaredNorm();
@@ -206,8 +300,33 @@ class FreeDecayFitter : public NestedModelFitter {
     return f;
   }
 
+  static bool strictSubset(const std::vector<std::string>& a, const std::vector<std::string>& b) {
+    if (a.size() >= b.size()) return false;
+    for (const auto& x : a)
+      if (std::find(b.begin(), b.end(), x) == b.end()) return false;
+    return true;
+  }
+
+  /// y - D-bar z of (2.8) block by block (the stacked D is never formed).
+  Eigen::VectorXd equationResidualsStreamed(const ResonatorModel& model, const Eigen::VectorXd& z,
+                                            const SlowRecord& record) const {
+    Eigen::VectorXd r(4 * static_cast<Eigen::Index>(record.size() - 2));
+    Eigen::Index i = 0;
+    forEachFreeDecayBlock(
+        model, record, options_.identification.uniform_time_tolerance,
+        [&](const RegressionBlock& b) { r.segment<4>(4 * i++) = b.y - *b.d * z; });
+    r.conservativeResize(4 * i);
+    return r;
+  }
+  Eigen::VectorXd equationResidualsStreamed(const ResonatorModel& model,
+                                            const Eigen::VectorXd& z) const {
+    return equationResidualsStreamed(model, z, record_);
+  }
+
   SlowRecord record_;
   NestedFitterOptions options_;
+  mutable EquationErrorFactor factor_;
+  mutable std::vector<std::vector<std::string>> fitted_cheap_;
 };
 
 class ForcedFitter : public NestedModelFitter {

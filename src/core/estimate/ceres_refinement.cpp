@@ -5,6 +5,7 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <sstream>
 
 #include "cvg_bench/core/demod/demodulator_noise.h"
@@ -12,6 +13,7 @@
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/hac_covariance.h"
 #include "cvg_bench/core/estimate/identifiability.h"
+#include "cvg_bench/core/estimate/least_squares_solver.h"
 #include "cvg_bench/core/estimate/output_error_forced.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
 #include "cvg_bench/core/estimate/residual_correlation.h"
@@ -92,6 +94,9 @@ struct FittedProblem {
   /// samples l apart (demodulator_noise.h); residual rows are 4 per sample, time-ordered. Empty =
   /// white noise.
   std::vector<double> noise_correlation;
+  /// Free decay: the residuals and the Jacobian of the unscaled unknowns written straight into
+  /// dense storage (no sparse copy); empty = through ceres::Problem::Evaluate.
+  std::function<bool(Eigen::MatrixXd*, Eigen::VectorXd*)> evaluate_dense;
 };
 
 void solveOrThrow(ceres::Problem* problem, const CeresOptions& options,
@@ -136,6 +141,19 @@ struct AtSolution {
 };
 
 AtSolution evaluateAtSolution(const FittedProblem& fp) {
+  if (fp.evaluate_dense) {
+    AtSolution a;
+    if (!fp.evaluate_dense(&a.j, &a.residuals))
+      throw AnalysisError("Ceres refinement: residuals cannot be evaluated at the solution");
+    a.cost = 0.5 * a.residuals.squaredNorm();
+    a.scale = fp.scale.size() == a.j.cols() ? fp.scale : Eigen::VectorXd::Ones(a.j.cols());
+    a.x.resize(a.j.cols());
+    for (size_t b = 0, o = 0; b < fp.blocks.size(); o += fp.block_sizes[b], ++b)
+      a.x.segment(o, fp.block_sizes[b]) =
+          Eigen::Map<const Eigen::VectorXd>(fp.blocks[b], fp.block_sizes[b]);
+    a.x = a.x.cwiseProduct(a.scale);
+    return a;
+  }
   ceres::Problem::EvaluateOptions eo;
   eo.parameter_blocks = fp.blocks;
   AtSolution a;
@@ -169,10 +187,25 @@ RankAnalysis numericalRank(const Eigen::MatrixXd& j, double tolerance) {
   r.norms = j.colwise().norm().transpose();
   for (Eigen::Index c = 0; c < r.norms.size(); ++c)
     if (r.norms[c] == 0.0) r.norms[c] = 1.0;
-  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(j * r.norms.cwiseInverse().asDiagonal(),
-                                              Eigen::ComputeFullV);
-  r.s = svd.singularValues();
-  r.v = svd.matrixV();
+  const Eigen::VectorXd inv_norms = r.norms.cwiseInverse();
+  if (j.cols() <= kMaxModelParameters) {
+    // Same singular values and V as the SVD of the tall matrix, from its triangular factor
+    // folded in by rows (no copy of the n x p Jacobian).
+    IncrementalQr qr(static_cast<int>(j.cols()));
+    constexpr Eigen::Index kRows = 256;
+    for (Eigen::Index r0 = 0; r0 < j.rows(); r0 += kRows) {
+      const Eigen::Index len = std::min(kRows, j.rows() - r0);
+      qr.addRows(j.middleRows(r0, len) * inv_norms.asDiagonal(), Eigen::VectorXd::Zero(len));
+    }
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(qr.rAug().topLeftCorner(j.cols(), j.cols()),
+                                                Eigen::ComputeFullV);
+    r.s = svd.singularValues();
+    r.v = svd.matrixV();
+  } else {
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(j * inv_norms.asDiagonal(), Eigen::ComputeFullV);
+    r.s = svd.singularValues();
+    r.v = svd.matrixV();
+  }
   for (Eigen::Index i = 0; i < r.s.size(); ++i)
     if (r.s[i] > tolerance * r.s[0]) ++r.rank;
   return r;
@@ -184,6 +217,24 @@ Eigen::MatrixXd unscaledCovariance(const FittedProblem& fp, const AtSolution& a,
                                    const RankAnalysis& r, const CeresOptions& options,
                                    Estimate* e) {
   const int p = static_cast<int>(a.j.cols());
+  const char* kRefusedNote =
+      "covariance from the SVD of the column-equilibrated Jacobian (ceres::Covariance judged "
+      "J'J too ill-conditioned before equilibration)";
+  if (r.rank == p && r.s.size() == p && r.s[p - 1] > 0.0) {
+    // Full rank: (J'J)^-1 from the SVD already taken (ceres::Covariance would evaluate and copy
+    // the n x p Jacobian again). Its DENSE_SVD refuses when the singular values of the Jacobian
+    // of the stored (scaled) blocks fall below sqrt(min_reciprocal_condition_number) of the
+    // largest; the result is this same formula then, with the note.
+    const Eigen::VectorXd sv =
+        Eigen::JacobiSVD<Eigen::MatrixXd>(r.s.asDiagonal() * r.v.transpose() *
+                                          r.norms.cwiseProduct(a.scale).asDiagonal())
+            .singularValues();
+    if (!(sv[p - 1] >= std::sqrt(options.min_reciprocal_condition_number) * sv[0]))
+      e->notes.push_back(kRefusedNote);
+    const Eigen::MatrixXd w =
+        r.norms.cwiseInverse().asDiagonal() * r.v * r.s.cwiseInverse().asDiagonal();
+    return w * w.transpose();
+  }
   ceres::Covariance::Options co;
   co.algorithm_type = ceres::DENSE_SVD;
   co.null_space_rank = p - r.rank;
@@ -197,9 +248,7 @@ Eigen::MatrixXd unscaledCovariance(const FittedProblem& fp, const AtSolution& a,
   // ceres::Covariance refused (its condition test runs on the unequilibrated J'J).
   const Eigen::MatrixXd v = r.v.leftCols(r.rank);
   const Eigen::VectorXd inv_s2 = r.s.head(r.rank).cwiseAbs2().cwiseInverse();
-  e->notes.push_back(
-      "covariance from the SVD of the column-equilibrated Jacobian (ceres::Covariance judged "
-      "J'J too ill-conditioned before equilibration)");
+  e->notes.push_back(kRefusedNote);
   return r.norms.cwiseInverse().asDiagonal() * v * inv_s2.asDiagonal() * v.transpose() *
          r.norms.cwiseInverse().asDiagonal();
 }
@@ -210,6 +259,44 @@ double blockLagOne(const Eigen::VectorXd& r) {
   const double ss = r.squaredNorm();
   if (n <= 8 || !(ss > 0.0)) return 0.0;
   return r.tail(n - 4).dot(r.head(n - 4)) / ss;
+}
+
+/// J' Sigma J for residual rows 4 per sample, Sigma_{i,i+4l} = rho_l (l = 1..rho.size(), 4 l < n):
+/// J'J + sum_l rho_l (A_l + A_l'), A_l = J[0, n-4l)' J[4l, n). Column by column: w = sum_l rho_l
+/// (column shifted by 4 l rows), then J' w is column b of sum_l rho_l A_l. A geometric rho
+/// (rho_l = rho_1^l, the fitted AR(1)) sums by a backward recursion, O(n) per column whatever the
+/// number of lags; other lists directly, O(n L).
+Eigen::MatrixXd correlatedGram(const Eigen::MatrixXd& j, const std::vector<double>& rho) {
+  const long n = j.rows();
+  Eigen::MatrixXd gram = j.transpose() * j;
+  long lags = 0;
+  while (lags < static_cast<long>(rho.size()) && 4 * (lags + 1) < n) ++lags;
+  if (lags == 0) return gram;
+  const double r1 = rho[0];
+  bool geometric = lags >= 3 && r1 != 0.0;
+  for (long l = 1; l < lags && geometric; ++l)
+    geometric = std::abs(rho[l] - rho[l - 1] * r1) <= 1e-12 * std::abs(rho[l]);
+  const double tail = geometric ? rho[lags - 1] * r1 : 0.0;
+  const long reach = 4 * (lags + 1);
+  Eigen::VectorXd w(n);
+  for (Eigen::Index b = 0; b < j.cols(); ++b) {
+    const auto x = j.col(b);
+    if (geometric) {
+      // w_i = sum_{l=1..L} r^l x_{i+4l} = r (x_{i+4} + w_{i+4}) - r^{L+1} x_{i+4(L+1)}.
+      for (long i = n - 1; i >= 0; --i) {
+        double v = i + 4 < n ? r1 * (x[i + 4] + w[i + 4]) : 0.0;
+        if (i + reach < n) v -= tail * x[i + reach];
+        w[i] = v;
+      }
+    } else {
+      w.setZero();
+      for (long l = 1; l <= lags; ++l) w.head(n - 4 * l) += rho[l - 1] * x.tail(n - 4 * l);
+    }
+    const Eigen::VectorXd v = j.transpose() * w;
+    gram.col(b) += v;
+    gram.row(b) += v.transpose();
+  }
+  return gram;
 }
 
 /// Covariance of all unknowns: white (iid), the record's stated noise correlation, or HAC when
@@ -264,13 +351,7 @@ CeresCovariance outputErrorCovariance(const FittedProblem& fp, const AtSolution&
   if (rho.empty()) return out;
   // Noise correlation Sigma (same channel, samples l apart: rho_l): with C = (J'J)^+ and
   // S = J' Sigma J, cov = sigma^2 C S C and E[RSS] = sigma^2 (n - tr(C S)).
-  const Eigen::MatrixXd& j = a.j;
-  Eigen::MatrixXd s_mat = j.transpose() * j;
-  for (size_t l = 1; l <= rho.size() && 4 * static_cast<long>(l) < n; ++l) {
-    const long rows = n - 4 * static_cast<long>(l);
-    const Eigen::MatrixXd m = j.topRows(rows).transpose() * j.bottomRows(rows);
-    s_mat += rho[l - 1] * (m + m.transpose());
-  }
+  const Eigen::MatrixXd s_mat = correlatedGram(a.j, rho);
   const double effective_dof = n - (unscaled * s_mat).trace();
   if (!(effective_dof > 0.0)) {
     e->notes.push_back(
@@ -425,14 +506,20 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
   if (!(q0_scale > 0)) q0_scale = 1.0;
   Eigen::VectorXd z = z_start.cwiseQuotient(z_scale);
   Eigen::Vector4d q0 = record.q.front() / q0_scale;
+  // Solved in square-root form (k + 5 residuals, the per-sample rows folded as they are made);
+  // rank and covariance from the per-sample problem below.
+  ceres::Problem square_root;
+  square_root.AddResidualBlock(
+      makeFreeDecaySquareRootCost(model, record, options.rk4_substeps, z_scale, q0_scale).release(),
+      nullptr, z.data(), q0.data());
+  ceres::Solver::Summary summary;
+  solveOrThrow(&square_root, options, &summary);
   ceres::Problem problem;
   problem.AddResidualBlock(
       makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps,
                                    TrajectoryDerivative::kSensitivity, z_scale, q0_scale)
           .release(),
       nullptr, z.data(), q0.data());
-  ceres::Solver::Summary summary;
-  solveOrThrow(&problem, options, &summary);
 
   Estimate e = start;
   e.mode = ExperimentMode::kFreeDecay;
@@ -462,6 +549,10 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
   fp.scale << z_scale, Eigen::Vector4d::Constant(q0_scale);
   fp.q = &record.q;
   fp.noise_correlation = noiseCorrelationFromMetadata(record.metadata);
+  fp.evaluate_dense = [&](Eigen::MatrixXd* j, Eigen::VectorXd* r) {
+    return evaluateFreeDecayOutputError(model, record, options.rk4_substeps,
+                                        z.cwiseProduct(z_scale), q0_scale * q0, j, r);
+  };
   finishEstimate(fp, options, &e);
   return e;
 }

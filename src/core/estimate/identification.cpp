@@ -94,52 +94,56 @@ struct SolvedSystem {
   ExcitationSummary excitation;
 };
 
-SolvedSystem solveSystem(const BlockStream& stream, const SystemInfo& info,
-                         const IdentificationOptions& opt, Estimate* e) {
-  const int k = static_cast<int>(info.names.size());
-  const bool rls = opt.method == "rls";
-  IncrementalQr qr(k);
+/// What pass 1 folds in: the QR of all blocks, the excitation and, for method rls, block RLS
+/// (2.12) initialised by QR on the first `m_init` blocks.
+struct FirstPass {
+  FirstPass(int k, const IdentificationOptions& opt)
+      : rls(opt.method == "rls"),
+        m_init(opt.rls_init_blocks > 0 ? opt.rls_init_blocks : std::max(2 * k, 8)),
+        qr(k),
+        qr_init(k),
+        filter(k, opt.rls_forgetting) {}
+  bool rls;
+  int m_init;
+  IncrementalQr qr, qr_init;
+  BlockRecursiveLeastSquares filter;
   SquaredExcitation excitation;
-  const int m_init = opt.rls_init_blocks > 0 ? opt.rls_init_blocks : std::max(2 * k, 8);
-  IncrementalQr qr_init(k);
-  BlockRecursiveLeastSquares filter(k, opt.rls_forgetting);
-  long block_no = 0;
   bool rls_failed = false;
+};
+
+void foldBlocks(const BlockStream& stream, FirstPass* p) {
+  long block_no = 0;
   stream([&](int, const RegressionBlock& b) {
-    qr.addBlock(*b.d, b.y);
-    excitation.add(b.q);
-    if (rls && !rls_failed) {
-      if (block_no < m_init) {
-        qr_init.addBlock(*b.d, b.y);
+    p->qr.addBlock(*b.d, b.y);
+    p->excitation.add(b.q);
+    if (p->rls && !p->rls_failed) {
+      if (block_no < p->m_init) {
+        p->qr_init.addBlock(*b.d, b.y);
       } else {
-        if (!filter.initialized()) {
+        if (!p->filter.initialized()) {
           try {
-            filter.initialize(qr_init.rAug(), qr_init.numRows());
+            p->filter.initialize(p->qr_init.rAug(), p->qr_init.numRows());
           } catch (const AnalysisError&) {
-            rls_failed = true;
+            p->rls_failed = true;
           }
         }
-        if (!rls_failed) filter.update(*b.d, b.y);
+        if (!p->rls_failed) p->filter.update(*b.d, b.y);
       }
     }
     ++block_no;
   });
-  SolvedSystem s;
-  s.n = qr.numRows();
-  if (s.n <= k)
-    throw InputError(std::to_string(s.n) + " equations for " + std::to_string(k) +
-                     " parameters of model " + info.model + ": more data needed (n > k)");
-  s.r = qr.rAug().topLeftCorner(k, k);
-  s.ls = solveTriangular(qr.rAug(), s.n, opt.rank_tolerance);
-  s.excitation = excitation.summary();
-  const LeastSquaresSolution& ls = s.ls;
+}
 
+/// The estimate's size, rank, options and the batch LS values.
+void describeSolution(const SolvedSystem& s, const SystemInfo& info,
+                      const IdentificationOptions& opt, Estimate* e) {
+  const LeastSquaresSolution& ls = s.ls;
   e->mode = info.mode;
   e->model = info.model;
   e->method = opt.method;
   e->omega_rad_s = info.omega_rad_s;
   e->n_equations = static_cast<int>(s.n);
-  e->n_params = k;
+  e->n_params = static_cast<int>(info.names.size());
   e->rank = ls.rank;
   e->dof = static_cast<int>(s.n - ls.rank);
   e->confidence = opt.confidence;
@@ -149,22 +153,42 @@ SolvedSystem solveSystem(const BlockStream& stream, const SystemInfo& info,
                             ls.singular_values.data() + ls.singular_values.size());
   e->notes = info.notes;
   e->values = ls.z;
-  if (rls) {
-    if (rls_failed || !filter.initialized() || ls.rank < k) {
-      e->notes.push_back("RLS not run: the first " + std::to_string(m_init) +
-                         " blocks (or the whole record) do not determine all parameters; "
-                         "batch LS result reported");
-      e->method = "ls";
-    } else {
-      e->values = filter.z();
-      e->notes.push_back(
-          "block RLS (2.12) with the corrected pairing y_{i+1} - D_{i+1} z_i "
-          "(docs/paper.md item 9), initialised by QR on the first " +
-          std::to_string(m_init) + " blocks, forgetting factor " + fmt(opt.rls_forgetting) +
-          "; paper's prediction bound (sigma_e = sigma) " +
-          fmt(filter.predictionSigmaBound(filter.sigma())));
-    }
+}
+
+/// Method rls: the filter's values where it ran, else the batch LS answer with the reason.
+void applyRls(FirstPass& p, const LeastSquaresSolution& ls, int k, const IdentificationOptions& opt,
+              Estimate* e) {
+  if (p.rls_failed || !p.filter.initialized() || ls.rank < k) {
+    e->notes.push_back("RLS not run: the first " + std::to_string(p.m_init) +
+                       " blocks (or the whole record) do not determine all parameters; "
+                       "batch LS result reported");
+    e->method = "ls";
+    return;
   }
+  e->values = p.filter.z();
+  e->notes.push_back(
+      "block RLS (2.12) with the corrected pairing y_{i+1} - D_{i+1} z_i "
+      "(docs/paper.md item 9), initialised by QR on the first " +
+      std::to_string(p.m_init) + " blocks, forgetting factor " + fmt(opt.rls_forgetting) +
+      "; paper's prediction bound (sigma_e = sigma) " +
+      fmt(p.filter.predictionSigmaBound(p.filter.sigma())));
+}
+
+SolvedSystem solveSystem(const BlockStream& stream, const SystemInfo& info,
+                         const IdentificationOptions& opt, Estimate* e) {
+  const int k = static_cast<int>(info.names.size());
+  FirstPass pass(k, opt);
+  foldBlocks(stream, &pass);
+  SolvedSystem s;
+  s.n = pass.qr.numRows();
+  if (s.n <= k)
+    throw InputError(std::to_string(s.n) + " equations for " + std::to_string(k) +
+                     " parameters of model " + info.model + ": more data needed (n > k)");
+  s.r = pass.qr.rAug().topLeftCorner(k, k);
+  s.ls = solveTriangular(pass.qr.rAug(), s.n, opt.rank_tolerance);
+  s.excitation = pass.excitation.summary();
+  describeSolution(s, info, opt, e);
+  if (pass.rls) applyRls(pass, s.ls, k, opt, e);
   return s;
 }
 
@@ -184,37 +208,43 @@ void recordCorrelationTest(const SerialCorrelationTest& t, Estimate* e) {
   e->residual_correlated = t.correlated;
 }
 
-/// Free decay (2.7): errors in variables, noise on q white, AR(1) (fitted to the residual
-/// correlations when the lag-1 test rejects independence) or the record's stated correlation.
-HonestCovariance freeDecayCovariance(const BlockStream& stream, const SystemInfo& info,
-                                     const SolvedSystem& s, Estimate* e) {
-  const int k = static_cast<int>(info.names.size());
-  const Eigen::VectorXd z = e->values;
-  const Eigen::MatrixXd& c = s.ls.unscaled_covariance;
-  const int dof_paper = static_cast<int>(s.n - s.ls.rank);
-  HonestCovariance h;
-  h.dof = dof_paper;
-  FreeDecayNoisePropagation propagation(*info.resonator, z);
+/// Pass 2 of free decay: residual sum, residual correlations, the sensitivities of the equation
+/// errors to the noise on q (free_decay_noise_propagation.h) and the envelope fit.
+struct ResidualPass {
+  double rss = 0.0;
+  long blocks = 0;
+  std::vector<double> corr;  ///< residual correlations at lags 1..kResidualLags
+  long steps = 0;
+};
+
+ResidualPass residualPass(const BlockStream& stream, const Eigen::VectorXd& z, int k,
+                          FreeDecayNoisePropagation* propagation, Estimate* e) {
+  ResidualPass out;
   ResidualLagAccumulator lags(kResidualLags);
   Eigen::VectorXd env_num = Eigen::VectorXd::Zero(k);
   double env_den = 0.0;
-  long blocks = 0;
   bool record_start = true;
   stream([&](int, const RegressionBlock& b) {
     if (record_start) lags.startRecord();
     const Eigen::Vector4d r = blockResidual(*b.d, z, b.y);
-    h.rss += r.squaredNorm();
+    out.rss += r.squaredNorm();
     lags.add(r);
-    propagation.add(b);
+    propagation->add(b);
     env_num.noalias() += b.d->transpose() * b.q;
     env_den += b.q.squaredNorm() * (b.t_next - b.t_prev);
-    ++blocks;
+    ++out.blocks;
     record_start = b.last_in_record;
   });
   if (env_den > 0.0) e->envelope_coefficients = -env_num / env_den;
-  const std::vector<double> corr = lags.correlations();
-  const SerialCorrelationTest test = testLagOne(corr[0], 0.0, 1.5, lags.steps());
-  recordCorrelationTest(test, e);
+  out.corr = lags.correlations();
+  out.steps = lags.steps();
+  return out;
+}
+
+/// The noise model on q: the record's stated correlation, AR(1) fitted to the residual
+/// correlations when the lag-1 test rejects independence, else white.
+NoiseCorrelation freeDecayNoiseModel(const SystemInfo& info, const SerialCorrelationTest& test,
+                                     const std::vector<double>& corr, Estimate* e) {
   NoiseCorrelation rho;
   if (!info.noise_correlation.empty()) {
     rho.lags = info.noise_correlation;
@@ -230,20 +260,45 @@ HonestCovariance freeDecayCovariance(const BlockStream& stream, const SystemInfo
     e->interval_method_id = "eiv_white";
     e->noise_model = "white";
   }
+  return rho;
+}
+
+/// Pass 3 (correlated noise only): the sensitivities again, correlated (correlated_noise_gram.h).
+Eigen::MatrixXd correlatedMeat(const BlockStream& stream, const SystemInfo& info,
+                               const Eigen::VectorXd& z, int k, const NoiseCorrelation& rho) {
+  FreeDecayNoisePropagation again(*info.resonator, z);
+  CorrelatedSensitivityGram gram(k, rho);
+  again.setSampleSink([&](const RegressionBlockMatrix& w, bool first) { gram.add(w, first); });
+  stream([&](int, const RegressionBlock& b) { again.add(b); });
+  return gram.sum();
+}
+
+/// Free decay (2.7): errors in variables, noise on q white, AR(1) (fitted to the residual
+/// correlations when the lag-1 test rejects independence) or the record's stated correlation.
+HonestCovariance freeDecayCovariance(const BlockStream& stream, const SystemInfo& info,
+                                     const SolvedSystem& s, Estimate* e) {
+  const int k = static_cast<int>(info.names.size());
+  const Eigen::VectorXd z = e->values;
+  const Eigen::MatrixXd& c = s.ls.unscaled_covariance;
+  const int dof_paper = static_cast<int>(s.n - s.ls.rank);
+  HonestCovariance h;
+  h.dof = dof_paper;
+  FreeDecayNoisePropagation propagation(*info.resonator, z);
+  const ResidualPass pass = residualPass(stream, z, k, &propagation, e);
+  h.rss = pass.rss;
+  const std::vector<double>& corr = pass.corr;
+  const SerialCorrelationTest test = testLagOne(corr[0], 0.0, 1.5, pass.steps);
+  recordCorrelationTest(test, e);
+  const NoiseCorrelation rho = freeDecayNoiseModel(info, test, corr, e);
   Eigen::MatrixXd meat;
   double gain = propagation.noiseGain();
   if (rho.white()) {
     meat = propagation.sensitivityGram();
   } else {
-    // Pass 3: the sensitivities again, correlated (correlated_noise_gram.h). E[RSS] gains
-    // 2 rho_2 tr(A_i,i-1 A_i,i+1') ~ -32 rho_2 per equation block (A ~ -/+2 I; the w G parts
-    // of A are O(h ||G||) and left out).
-    FreeDecayNoisePropagation again(*info.resonator, z);
-    CorrelatedSensitivityGram gram(k, rho);
-    again.setSampleSink([&](const RegressionBlockMatrix& w, bool first) { gram.add(w, first); });
-    stream([&](int, const RegressionBlock& b) { again.add(b); });
-    meat = gram.sum();
-    gain -= 32.0 * rho.at(2) * static_cast<double>(blocks);
+    // E[RSS] gains 2 rho_2 tr(A_i,i-1 A_i,i+1') ~ -32 rho_2 per equation block (A ~ -/+2 I; the
+    // w G parts of A are O(h ||G||) and left out).
+    meat = correlatedMeat(stream, info, z, k, rho);
+    gain -= 32.0 * rho.at(2) * static_cast<double>(pass.blocks);
   }
   const double sigma_q2 = gain > 0.0 ? h.rss / gain * static_cast<double>(s.n) / dof_paper : 0.0;
   h.covariance = sigma_q2 * c * meat * c;

@@ -3,6 +3,10 @@
 #include <ceres/cost_function.h>
 #include <ceres/dynamic_numeric_diff_cost_function.h>
 
+#include <cmath>
+
+#include "cvg_bench/core/estimate/least_squares_solver.h"
+
 namespace cvg_bench {
 
 namespace {
@@ -19,9 +23,10 @@ void stage(const ResonatorModel& model, const Eigen::VectorXd& z, double t,
   const SlowContext ctx{t, 0.0};
   model.regressor(q, ctx, *d);
   const int p = model.numParameters();
-  *k = 0.5 * (*d * z);
+  *k = 0.5 * d->lazyProduct(z);
   const Eigen::Matrix4d a = model.slowJacobian(q, ctx, z);
-  ks->noalias() = a * s;
+  // Column by column: fixed-size 4 x 4 times 4-vector products (vectorized, no GEMM dispatch).
+  for (Eigen::Index j = 0; j < s.cols(); ++j) ks->col(j).noalias() = a * s.col(j);
   ks->leftCols(p) += 0.5 * *d;
 }
 
@@ -57,6 +62,34 @@ bool integrateWithSensitivities(const ResonatorModel& model, const Eigen::Vector
     }
     if (!q.allFinite() || !s.allFinite()) return false;
     visit(i, q, s);
+  }
+  return true;
+}
+
+/// RK4 of the trajectory alone; visit(i, q_i) at every sample, nothing stored.
+template <typename Visit>
+bool forEachTrajectoryPoint(const ResonatorModel& model, const Eigen::VectorXd& z,
+                            const Eigen::Vector4d& q0, const std::vector<double>& t_s, int substeps,
+                            Visit&& visit) {
+  if (t_s.empty()) return true;
+  const double t0 = t_s.front();
+  Eigen::Vector4d q = q0;
+  visit(size_t{0}, q);
+  auto rate = [&](double t, const Eigen::Vector4d& x) {
+    return model.slowDerivative(x, SlowContext{t - t0, 0.0}, z);
+  };
+  for (size_t i = 1; i < t_s.size(); ++i) {
+    const double h = (t_s[i] - t_s[i - 1]) / substeps;
+    double t = t_s[i - 1];
+    for (int s = 0; s < substeps; ++s, t += h) {
+      const Eigen::Vector4d k1 = rate(t, q);
+      const Eigen::Vector4d k2 = rate(t + h / 2, q + h / 2 * k1);
+      const Eigen::Vector4d k3 = rate(t + h / 2, q + h / 2 * k2);
+      const Eigen::Vector4d k4 = rate(t + h, q + h * k3);
+      q += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+    }
+    if (!q.allFinite()) return false;
+    visit(i, q);
   }
   return true;
 }
@@ -110,7 +143,138 @@ class FreeDecaySensitivityCost : public ceres::CostFunction {
   double q0_scale_;
 };
 
+/// The same output-error problem in square-root form for the solver: the stacked residuals
+/// r (4 (N + 1)) and Jacobian J are folded block by block into the triangular factor of [J | r]
+/// (IncrementalQr, never stored): [J | r] = Q [R c; 0 rho], so |r + J d|^2 = |c + R d|^2 + rho^2
+/// for every step d. The k + 5 residuals [c; rho] with Jacobian [R; 0] give Levenberg-Marquardt
+/// the same cost, gradient J'r, Gauss-Newton matrix J'J and Jacobi column scaling as the full
+/// problem, in O((k + 4)^2) memory. A cost-only evaluation returns |r| in the last residual.
+class FreeDecaySquareRootCost : public ceres::CostFunction {
+ public:
+  FreeDecaySquareRootCost(const ResonatorModel& model, const SlowRecord& record, int substeps,
+                          const Eigen::VectorXd& z_scale, double q0_scale)
+      : model_(model),
+        record_(record),
+        substeps_(substeps),
+        z_scale_(z_scale.size() == 0 ? Eigen::VectorXd::Ones(model.numParameters()) : z_scale),
+        q0_scale_(q0_scale) {
+    set_num_residuals(model.numParameters() + 5);
+    mutable_parameter_block_sizes()->push_back(model.numParameters());
+    mutable_parameter_block_sizes()->push_back(4);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const int p = model_.numParameters();
+    const int m = p + 4;
+    const Eigen::VectorXd z =
+        z_scale_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(parameters[0], p));
+    const Eigen::Vector4d q0 = q0_scale_ * Eigen::Map<const Eigen::Vector4d>(parameters[1]);
+    Eigen::Map<Eigen::VectorXd> out(residuals, m + 1);
+    out.setZero();
+    if (jacobians == nullptr || (jacobians[0] == nullptr && jacobians[1] == nullptr)) {
+      double ss = 0.0;
+      const bool ok = forEachTrajectoryPoint(
+          model_, z, q0, record_.t_s, substeps_,
+          [&](size_t i, const Eigen::Vector4d& q) { ss += (q - record_.q[i]).squaredNorm(); });
+      out[m] = std::sqrt(ss);
+      return ok && std::isfinite(ss);
+    }
+    IncrementalQr qr(m);
+    RegressionBlockMatrix block(4, m);
+    const bool ok =
+        integrateWithSensitivities(model_, z, q0, record_.t_s, substeps_,
+                                   [&](size_t i, const Eigen::Vector4d& q, const Sensitivity& s) {
+                                     block.leftCols(p) = s.leftCols(p) * z_scale_.asDiagonal();
+                                     block.rightCols(4) = q0_scale_ * s.rightCols(4);
+                                     qr.addBlock(block, q - record_.q[i]);
+                                   });
+    if (!ok) return false;
+    const Eigen::MatrixXd& r_aug = qr.rAug();
+    out.head(m) = r_aug.col(m).head(m);
+    out[m] = r_aug(m, m);
+    if (jacobians[0] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> jz(
+          jacobians[0], m + 1, p);
+      jz.setZero();
+      jz.topRows(m) = r_aug.topLeftCorner(m, p);
+    }
+    if (jacobians[1] != nullptr) {
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor>> jq(jacobians[1], m + 1,
+                                                                               4);
+      jq.setZero();
+      jq.topRows(m) = r_aug.block(0, p, m, 4);
+    }
+    return out.allFinite();
+  }
+
+ private:
+  const ResonatorModel& model_;
+  const SlowRecord& record_;
+  int substeps_;
+  Eigen::VectorXd z_scale_;
+  double q0_scale_;
+};
+
 }  // namespace
+
+std::unique_ptr<ceres::CostFunction> makeFreeDecaySquareRootCost(const ResonatorModel& model,
+                                                                 const SlowRecord& record,
+                                                                 int substeps,
+                                                                 const Eigen::VectorXd& z_scale,
+                                                                 double q0_scale) {
+  return std::make_unique<FreeDecaySquareRootCost>(model, record, substeps, z_scale, q0_scale);
+}
+
+bool evaluateFreeDecayOutputError(const ResonatorModel& model, const SlowRecord& record,
+                                  int substeps, const Eigen::VectorXd& z, const Eigen::Vector4d& q0,
+                                  Eigen::MatrixXd* jacobian, Eigen::VectorXd* residuals) {
+  const int m = model.numParameters() + 4;
+  const size_t n = record.size();
+  jacobian->resize(4 * static_cast<Eigen::Index>(n), m);
+  residuals->resize(4 * static_cast<Eigen::Index>(n));
+  return integrateWithSensitivities(model, z, q0, record.t_s, substeps,
+                                    [&](size_t i, const Eigen::Vector4d& q, const Sensitivity& s) {
+                                      residuals->segment<4>(4 * i) = q - record.q[i];
+                                      jacobian->middleRows(4 * i, 4) = s;
+                                    }) &&
+         jacobian->allFinite() && residuals->allFinite();
+}
+
+bool integrateSlowInitialSensitivity(
+    const ResonatorModel& model, const Eigen::VectorXd& z, const Eigen::Vector4d& q0,
+    const std::vector<double>& t_s, int substeps,
+    const std::function<void(size_t, const Eigen::Vector4d&, const Eigen::Matrix4d&)>& visit) {
+  if (t_s.empty()) return true;
+  const double t0 = t_s.front();
+  Eigen::Vector4d q = q0;
+  Eigen::Matrix4d s = Eigen::Matrix4d::Identity();
+  visit(size_t{0}, q, s);
+  // One RK4 stage: k = q'(q), K = A(q) S with A = slowJacobian (2.6).
+  auto stage4 = [&](double t, const Eigen::Vector4d& x, const Eigen::Matrix4d& sx,
+                    Eigen::Vector4d* k, Eigen::Matrix4d* ks) {
+    const SlowContext ctx{t, 0.0};
+    *k = model.slowDerivative(x, ctx, z);
+    ks->noalias() = model.slowJacobian(x, ctx, z) * sx;
+  };
+  Eigen::Vector4d k1, k2, k3, k4;
+  Eigen::Matrix4d s1, s2, s3, s4;
+  for (size_t i = 1; i < t_s.size(); ++i) {
+    const double h = (t_s[i] - t_s[i - 1]) / substeps;
+    double t = t_s[i - 1] - t0;
+    for (int sub = 0; sub < substeps; ++sub, t += h) {
+      stage4(t, q, s, &k1, &s1);
+      stage4(t + h / 2, q + h / 2 * k1, s + h / 2 * s1, &k2, &s2);
+      stage4(t + h / 2, q + h / 2 * k2, s + h / 2 * s2, &k3, &s3);
+      stage4(t + h, q + h * k3, s + h * s3, &k4, &s4);
+      q += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+      s += h / 6 * (s1 + 2 * s2 + 2 * s3 + s4);
+    }
+    if (!q.allFinite() || !s.allFinite()) return false;
+    visit(i, q, s);
+  }
+  return true;
+}
 
 bool integrateSlowSensitivities(
     const ResonatorModel& model, const Eigen::VectorXd& z, const Eigen::Vector4d& q0,
@@ -129,27 +293,8 @@ bool integrateSlowTrajectory(const ResonatorModel& model, const Eigen::VectorXd&
                              const Eigen::Vector4d& q0, const std::vector<double>& t_s,
                              int substeps, std::vector<Eigen::Vector4d>* trajectory) {
   trajectory->resize(t_s.size());
-  if (t_s.empty()) return true;
-  const double t0 = t_s.front();
-  Eigen::Vector4d q = q0;
-  (*trajectory)[0] = q;
-  auto rate = [&](double t, const Eigen::Vector4d& x) {
-    return model.slowDerivative(x, SlowContext{t - t0, 0.0}, z);
-  };
-  for (size_t i = 1; i < t_s.size(); ++i) {
-    const double h = (t_s[i] - t_s[i - 1]) / substeps;
-    double t = t_s[i - 1];
-    for (int s = 0; s < substeps; ++s, t += h) {
-      const Eigen::Vector4d k1 = rate(t, q);
-      const Eigen::Vector4d k2 = rate(t + h / 2, q + h / 2 * k1);
-      const Eigen::Vector4d k3 = rate(t + h / 2, q + h / 2 * k2);
-      const Eigen::Vector4d k4 = rate(t + h, q + h * k3);
-      q += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
-    }
-    if (!q.allFinite()) return false;
-    (*trajectory)[i] = q;
-  }
-  return true;
+  return forEachTrajectoryPoint(model, z, q0, t_s, substeps,
+                                [&](size_t i, const Eigen::Vector4d& q) { (*trajectory)[i] = q; });
 }
 
 FreeDecayOutputError::FreeDecayOutputError(const ResonatorModel& model, const SlowRecord& record,

@@ -6,6 +6,9 @@
 //   hold-out = fit on the first (1 - holdout_fraction) of the samples, integrate the averaged
 //   equations (integrateSlowTrajectory, RK4) from the first measured sample over the whole record,
 //   RMS of q_model - q_measured over the held-out last part [units of q].
+//   Cheap (ranking) fits: the nested LS problems solved on the columns of the triangular factor
+//   of the widest equation-error system (one pass over the record per widening); residual vectors
+//   only for fits that are not strict subsets of an earlier one (the linear model, the widest).
 // Forced: fit = buildForcedSystem + estimateFromSystem (per-point cluster sandwich); with `mu` in
 //   the extensions, mu comes from the output-error fit (refineWithCeres) and z is then refitted by
 //   LS at that mu, so sigma stays in equation units; the Wald test of mu uses the Ceres covariance.

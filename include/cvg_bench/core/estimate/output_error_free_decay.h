@@ -17,6 +17,7 @@
 #include <ceres/cost_function.h>
 
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -38,6 +39,13 @@ bool integrateSlowSensitivities(const ResonatorModel& model, const Eigen::Vector
                                 const Eigen::Vector4d& q0, const std::vector<double>& t_s,
                                 int substeps, std::vector<Eigen::Vector4d>* trajectory,
                                 std::vector<Eigen::Matrix<double, 4, Eigen::Dynamic>>* sensitivity);
+
+/// The trajectory and d q(t_i) / d q(t_0) (4 x 4) alone, sample by sample: visit(i, q_i, S_i).
+/// For fits of the initial state at fixed z (a quarter of the work of all sensitivities).
+bool integrateSlowInitialSensitivity(
+    const ResonatorModel& model, const Eigen::VectorXd& z, const Eigen::Vector4d& q0,
+    const std::vector<double>& t_s, int substeps,
+    const std::function<void(size_t, const Eigen::Vector4d&, const Eigen::Matrix4d&)>& visit);
 
 /// The residual functor: parameter blocks (z [numParameters()], q(t_0) [4]), each in units of its
 /// scale: z = z_scale .* x_z, q(t_0) = q0_scale * x_q. Scaling makes the unknowns O(1), so the
@@ -73,5 +81,20 @@ std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(
     const ResonatorModel& model, const SlowRecord& record, int substeps,
     TrajectoryDerivative derivative = TrajectoryDerivative::kSensitivity,
     const Eigen::VectorXd& z_scale = Eigen::VectorXd(), double q0_scale = 1.0);
+
+/// The same problem in square-root form for the solver (k + 5 residuals, nothing per sample kept):
+/// the factor [R c; 0 rho] of [J | r] folded sample by sample; LM sees the same cost, gradient and
+/// Gauss-Newton matrix as with makeFreeDecayOutputErrorCost(kSensitivity). Not for the covariance
+/// or the residual tests (they need the per-sample rows: evaluateFreeDecayOutputError).
+std::unique_ptr<ceres::CostFunction> makeFreeDecaySquareRootCost(
+    const ResonatorModel& model, const SlowRecord& record, int substeps,
+    const Eigen::VectorXd& z_scale = Eigen::VectorXd(), double q0_scale = 1.0);
+
+/// Residuals r_i = q_model(t_i) - q_measured(t_i) (4 (N + 1)) and their Jacobian with respect to
+/// the unscaled unknowns (z, q(t_0)), 4 (N + 1) x (numParameters() + 4), by forward sensitivities,
+/// written straight into dense storage. False when the trajectory overflows.
+bool evaluateFreeDecayOutputError(const ResonatorModel& model, const SlowRecord& record,
+                                  int substeps, const Eigen::VectorXd& z, const Eigen::Vector4d& q0,
+                                  Eigen::MatrixXd* jacobian, Eigen::VectorXd* residuals);
 
 }  // namespace cvg_bench
