@@ -412,6 +412,26 @@ class BadInputSuite(unittest.TestCase):
             path = self.write(blob, suffix=".bag", binary=True)
             self.check(label, ["identify", path, "--mode", "free_decay", "--model", "linear"],
                        "bad", names=(path,))
+        # Stored lengths rosbag would trust (it allocated 2.3e9 bytes for the fuzz input): the
+        # bag's structure is walked first, the message names the byte offset.
+        starts, pos = [], 13
+        while pos + 4 <= len(data):
+            starts.append(pos)
+            hlen = int.from_bytes(data[pos:pos + 4], "little")
+            pos += 4 + hlen
+            pos += 4 + int.from_bytes(data[pos:pos + 4], "little")
+        self.assertEqual(pos, len(data))
+        big = (0x70000000).to_bytes(4, "little")
+        corrupt = [("fuzz: record length 2e9 (regression)",
+                    os.path.join(ROOT, "test", "fuzz", "regressions", "bag", "record_length_2e9.bag")),
+                   ("first record length 1.9e9", self.write(data[:13] + big + data[17:], ".bag",
+                                                            binary=True)),
+                   ("index record length 1.9e9", self.write(
+                       data[:starts[-1]] + big + data[starts[-1] + 4:], ".bag", binary=True))]
+        for label, path in corrupt:
+            rc, _, err = run_tool(["identify", path, "--mode", "free_decay", "--model", "linear"])
+            self.check(label, ["identify", path, "--mode", "free_decay", "--model", "linear"],
+                       "bad", names=(path,) if "no rosbag support" in err else (path, "byte"))
         self.check("bag with --mode forced", ["identify", BAG, "--mode", "forced", "--model",
                                               "linear"], "bad", names=(BAG,))
         rc, _, err = run_tool(["identify", BAG, "--mode", "free_decay", "--model", "linear"])
