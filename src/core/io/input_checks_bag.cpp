@@ -112,9 +112,12 @@ void requireBagStructure(const std::string& path) {
   if (!w.in) throw InputError(path + ": cannot open the bag");
   w.in.seekg(0, std::ios::end);
   const std::streamoff size = w.in.tellg();
+  // rosbag accepts any first line "#ROS<word> V<major>.<minor>" and copies <word> into a 100-byte
+  // buffer (fuzzing: "#ROSB#ROSBAAG V2.0" passed it, then its header parser read past a record):
+  // only the exact format 2.0 line goes on.
   const size_t magic_len = std::strlen(kMagic);
-  if (size < static_cast<std::streamoff>(magic_len)) return;  // rosbag reports it
-  if (w.read(0, magic_len) != kMagic) return;                 // not format 2.0: rosbag reports it
+  if (size < static_cast<std::streamoff>(magic_len) || w.read(0, magic_len) != kMagic)
+    throw InputError(path + ": not a ROS bag of format 2.0 (the first line is not '#ROSBAG V2.0')");
   w.walk(magic_len, static_cast<uint64_t>(size), true);
   for (uint64_t at : w.must_start)
     if (!w.starts.count(at)) w.fail(at, "the index points inside a record");

@@ -15,8 +15,8 @@ namespace cvg_bench {
 /// Largest accepted uncompressed chunk [bytes] (rosbag's default chunk is 768 kB).
 constexpr uint64_t kMaxBagChunkBytes = uint64_t{1} << 30;
 
-/// InputError naming the file and the byte offset of the first record that does not fit. Files
-/// that are not bag format 2.0 are left to rosbag (which reports them).
+/// InputError naming the file and the byte offset of the first record that does not fit, or saying
+/// the file is not bag format 2.0 (first line exactly "#ROSBAG V2.0").
 void requireBagStructure(const std::string& path);
 
 }  // namespace cvg_bench
