@@ -427,6 +427,9 @@ class BadInputSuite(unittest.TestCase):
                    ("fuzz: version line '#ROSB#ROSBAAG V2.0' (regression)",
                     os.path.join(ROOT, "test", "fuzz", "regressions", "bag",
                                  "version_line_rosb_rosbaag.bag")),
+                   ("fuzz: connection header field length beyond its record (regression)",
+                    os.path.join(ROOT, "test", "fuzz", "regressions", "bag",
+                                 "connection_header_field_length.bag")),
                    ("version line with a 200-character word", self.write(
                        b"#ROS" + b"A" * 200 + b" V2.0\n" + data[13:], ".bag", binary=True)),
                    ("first record length 1.9e9", self.write(data[:13] + big + data[17:], ".bag",

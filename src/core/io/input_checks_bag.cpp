@@ -12,7 +12,7 @@ namespace cvg_bench {
 namespace {
 
 constexpr char kMagic[] = "#ROSBAG V2.0\n";
-constexpr uint8_t kOpBagHeader = 0x03, kOpChunk = 0x05, kOpChunkInfo = 0x06;
+constexpr uint8_t kOpBagHeader = 0x03, kOpChunk = 0x05, kOpChunkInfo = 0x06, kOpConnection = 0x07;
 
 struct Walker {
   std::ifstream in;
@@ -47,6 +47,24 @@ struct Walker {
     return x;
   }
 
+  /// A list of "name=value" fields, each after its 4-byte length (record headers, and the
+  /// connection header stored as a connection record's data), starting at file offset `at`.
+  std::vector<std::pair<std::string, std::string>> fields(uint64_t at, const std::string& bytes) {
+    std::vector<std::pair<std::string, std::string>> out;
+    for (size_t f = 0; f < bytes.size();) {
+      if (bytes.size() - f < 4) fail(at + f, "header field cut short");
+      const uint64_t n = le(bytes.substr(f, 4));
+      if (n > bytes.size() - f - 4)
+        fail(at + f, "header field length " + std::to_string(n) + " beyond the header");
+      const std::string field = bytes.substr(f + 4, n);
+      const size_t eq = field.find('=');
+      if (eq == std::string::npos) fail(at + f, "header field without '='");
+      out.emplace_back(field.substr(0, eq), field.substr(eq + 1));
+      f += 4 + n;
+    }
+    return out;
+  }
+
   /// Walks the records in [begin, end); top = the file's top level (not inside a chunk).
   void walk(uint64_t begin, uint64_t end, bool top) {
     uint64_t pos = begin;
@@ -67,22 +85,15 @@ struct Walker {
       std::string compression;
       uint64_t chunk_size = 0, index_pos = 0, chunk_pos = 0;
       bool has_size = false, has_index_pos = false, has_chunk_pos = false;
-      for (size_t f = 0; f < header.size();) {
-        if (header.size() - f < 4) fail(pos + 4 + f, "header field cut short");
-        const uint64_t n = le(header.substr(f, 4));
-        if (n > header.size() - f - 4)
-          fail(pos + 4 + f, "header field length " + std::to_string(n) + " beyond the header");
-        const std::string field = header.substr(f + 4, n);
-        f += 4 + n;
-        const size_t eq = field.find('=');
-        if (eq == std::string::npos) fail(pos + 4, "header field without '='");
-        const std::string name = field.substr(0, eq), value = field.substr(eq + 1);
+      for (const auto& nv : fields(pos + 4, header)) {
+        const std::string &name = nv.first, &value = nv.second;
         if (name == "op" && value.size() == 1) op = static_cast<uint8_t>(value[0]);
         if (name == "compression") compression = value;
         if (name == "size" && value.size() == 4) chunk_size = le(value), has_size = true;
         if (name == "index_pos" && value.size() == 8) index_pos = le(value), has_index_pos = true;
         if (name == "chunk_pos" && value.size() == 8) chunk_pos = le(value), has_chunk_pos = true;
       }
+      if (op == kOpConnection) fields(data_at, read(data_at, data_len));
       if (op == kOpBagHeader && top && has_index_pos && index_pos != 0)
         must_start.push_back(index_pos);
       if (op == kOpChunkInfo && has_chunk_pos) must_start.push_back(chunk_pos);
