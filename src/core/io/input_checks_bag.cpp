@@ -130,6 +130,7 @@ void requireBagStructure(const std::string& path) {
   if (size < static_cast<std::streamoff>(magic_len) || w.read(0, magic_len) != kMagic)
     throw InputError(path + ": not a ROS bag of format 2.0 (the first line is not '#ROSBAG V2.0')");
   w.walk(magic_len, static_cast<uint64_t>(size), true);
+  w.starts.insert(static_cast<uint64_t>(size));  // an empty bag's index starts at the end
   for (uint64_t at : w.must_start)
     if (!w.starts.count(at)) w.fail(at, "the index points inside a record");
 }
