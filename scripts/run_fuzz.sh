@@ -35,9 +35,12 @@ for t in "${targets[@]}"; do
   name=${t#fuzz_}
   case $name in csv_reader) c=csv;; params_json) c=params;; preset_yaml) c=preset;; bag_reader) c=bag;; esac
   mkdir -p "$b/corpus/$c" "$b/crashes/$c"
+  # Past findings (test/fuzz/regressions/<kind>/, also cases of the bad-input suite) are rerun first.
+  regress=()
+  [ -d "$root/test/fuzz/regressions/$c" ] && regress=("$root/test/fuzz/regressions/$c")
   echo "fuzz: $t for $secs s"
   if ! (cd "$b/crashes/$c" && "$b/$t" -max_total_time="$secs" -max_len=65536 -timeout=10 \
-        -rss_limit_mb=2048 -print_final_stats=1 "$b/corpus/$c" "$root/test/fuzz/corpus/$c" \
+        -rss_limit_mb=2048 -print_final_stats=1 "$b/corpus/$c" "$root/test/fuzz/corpus/$c" "${regress[@]}" \
         > "$b/$t.log" 2>&1); then
     failed=1
     echo "fuzz: $t FOUND A CRASH (log: $b/$t.log, input in $b/crashes/$c)"

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "cvg_bench/core/io/input_checks.h"
+#include "cvg_bench/core/io/input_checks_bag.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/ros/conversions.h"
 
@@ -290,6 +291,7 @@ bool isBagPath(const std::string& path) {
 AnyRecord readRecordBag(const std::string& path, const BagReadOptions& options) {
   if (options.kinds.empty()) throw InputError("readRecordBag: no acceptable record kind given");
   requireInputFile(path, "input bag");
+  requireBagStructure(path);
   AnyRecord out;
   try {
     rosbag::Bag bag;
@@ -321,6 +323,7 @@ AnyRecord readRecordBag(const std::string& path, const BagReadOptions& options) 
 }
 
 std::string describeBagTopics(const std::string& path) {
+  requireBagStructure(path);
   try {
     rosbag::Bag bag;
     bag.open(path, rosbag::bagmode::Read);

@@ -412,6 +412,36 @@ class BadInputSuite(unittest.TestCase):
             path = self.write(blob, suffix=".bag", binary=True)
             self.check(label, ["identify", path, "--mode", "free_decay", "--model", "linear"],
                        "bad", names=(path,))
+        # Stored lengths rosbag would trust (it allocated 2.3e9 bytes for the fuzz input): the
+        # bag's structure is walked first, the message names the byte offset.
+        starts, pos = [], 13
+        while pos + 4 <= len(data):
+            starts.append(pos)
+            hlen = int.from_bytes(data[pos:pos + 4], "little")
+            pos += 4 + hlen
+            pos += 4 + int.from_bytes(data[pos:pos + 4], "little")
+        self.assertEqual(pos, len(data))
+        big = (0x70000000).to_bytes(4, "little")
+        corrupt = [("fuzz: record length 2e9 (regression)",
+                    os.path.join(ROOT, "test", "fuzz", "regressions", "bag", "record_length_2e9.bag")),
+                   ("fuzz: version line '#ROSB#ROSBAAG V2.0' (regression)",
+                    os.path.join(ROOT, "test", "fuzz", "regressions", "bag",
+                                 "version_line_rosb_rosbaag.bag")),
+                   ("fuzz: connection header field length beyond its record (regression)",
+                    os.path.join(ROOT, "test", "fuzz", "regressions", "bag",
+                                 "connection_header_field_length.bag")),
+                   ("version line with a 200-character word", self.write(
+                       b"#ROS" + b"A" * 200 + b" V2.0\n" + data[13:], ".bag", binary=True)),
+                   ("first record length 1.9e9", self.write(data[:13] + big + data[17:], ".bag",
+                                                            binary=True)),
+                   ("index record length 1.9e9", self.write(
+                       data[:starts[-1]] + big + data[starts[-1] + 4:], ".bag", binary=True))]
+        for label, path in corrupt:
+            rc, _, err = run_tool(["identify", path, "--mode", "free_decay", "--model", "linear"])
+            self.check(label, ["identify", path, "--mode", "free_decay", "--model", "linear"],
+                       "bad", names=(path,))
+            self.assertTrue("no rosbag support" in err or "byte" in err or "format 2.0" in err,
+                            label + ": " + err)
         self.check("bag with --mode forced", ["identify", BAG, "--mode", "forced", "--model",
                                               "linear"], "bad", names=(BAG,))
         rc, _, err = run_tool(["identify", BAG, "--mode", "free_decay", "--model", "linear"])
