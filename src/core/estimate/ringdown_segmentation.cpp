@@ -251,6 +251,30 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
   seg.plateau_log_amplitude = c0;
   const double best_c = c0;
   size_t i_start = seg.has_plateau ? i_cross : 0;
+  // Detector settling: a lock-in or video filter rounds the corner at switch-off, so the decay rate
+  // starts near zero. The span starts where the local rate (over w samples) first reaches 90 % of
+  // the rate between 3 and 13 dB below the start (at most the first 3 dB of decay are skipped;
+  // damping that grows with amplitude makes the early rate higher, so nothing is skipped then).
+  if (i_end > i_start + 40) {
+    const double s0 = sm[i_start];
+    size_t a3 = i_end, a13 = i_end;
+    for (size_t i = i_start; i < i_end; ++i) {
+      if (!std::isfinite(sm[i])) continue;
+      if (a3 == i_end && sm[i] <= s0 - 3.0 / kDbPerNeper) a3 = i;
+      if (sm[i] <= s0 - 13.0 / kDbPerNeper) {
+        a13 = i;
+        break;
+      }
+    }
+    if (a3 < i_end && a13 > a3 + 8) {
+      const double ref = slopeOver(t, sm, seg.dropout, a3, a13);
+      const size_t w = std::max<size_t>(8, n / 200);
+      for (size_t i = i_start; i + w < a3; ++i) {
+        if (slopeOver(t, sm, seg.dropout, i, i + w) <= 0.9 * ref) break;
+        i_start = i + 1;
+      }
+    }
+  }
   if (i_end <= i_start + 8) throw AnalysisError("ring-down: no decay above the noise floor");
   seg.i_start = i_start;
   seg.i_end = i_end;

@@ -9,6 +9,9 @@
 //     median falls to `floor_margin_db` above the floor (the fit includes the floor).
 //  3. Drive switch-off: a hinge (constant, then a straight decline of ln A) fitted by QR on a grid
 //     of switch-off times; the span starts one median interval after the hinge.
+//     Detector settling: the span then starts where the local decay rate first reaches 90 % of the
+//     rate between 3 and 13 dB below the start (a lock-in's low-pass rounds the corner; at most
+//     the first 3 dB are skipped).
 //  4. Refusal: under 3 dB (or 10 robust sd) of decay, or under 8 samples in the span.
 #pragma once
 
