@@ -103,7 +103,7 @@ namespace {
 /// Blocked two-fold hold-out error of a model: the span's used samples in kHoldOutBlocks
 /// contiguous blocks, fitted on the even blocks and scored on the odd ones and back, started from
 /// the full fit. Returns the weighted squared prediction error over all samples (inf on failure).
-constexpr int kHoldOutBlocks = 16;
+constexpr int kHoldOutBlocks = 48;
 double holdOutError(const RingdownEnvelope& env, const RingdownSegment& seg,
                     const RingdownFit& full, const RingdownFitOptions& base) {
   std::vector<size_t> used;
