@@ -16,6 +16,7 @@ import json
 import math
 import os
 import sys
+import textwrap
 from collections import defaultdict
 
 import matplotlib
@@ -62,7 +63,7 @@ def main(d):
         ax.axhline(seg["floor_db"], color="k", ls=":", lw=1, label="noise floor")
     ax.set_xlabel("t [s]")
     ax.set_ylabel("level [dB]")
-    ax.set_title("ring-down envelope: " + seg["why"][:90], fontsize=8)
+    ax.set_title("\n".join(textwrap.wrap("ring-down envelope: " + seg["why"], 110)), fontsize=7)
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(os.path.join(d, "envelope.png"), dpi=110)
@@ -91,6 +92,7 @@ def main(d):
         q0 = x["final"]["derived_ci"].get("Q0")
         if q0:
             ax.axhline(q0["value"], color="#d62728", ls="--", label="Q0 (zero amplitude)")
+        ax.set_title("local Q per amplitude bin; final model " + x["final"]["model"], fontsize=8)
         ax.set_xscale("log")
         ax.set_xlabel("amplitude [file unit]")
         ax.set_ylabel("Q")

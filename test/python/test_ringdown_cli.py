@@ -71,6 +71,22 @@ class RingdownCli(unittest.TestCase):
         self.assertEqual(p.returncode, 2)
         self.assertIn("bad.csv:5", p.stderr)
 
+    def test_explain_report_writes_figures_and_summary(self):
+        rec, rep = self.path("rep.csv"), self.path("report")
+        run("simulate", "--mode", "ringdown", "--effect", "gamma_nl=0.15", "--floor-db", "-60",
+            "--dropouts", "3", "--seed", "12", "--out", rec)
+        p = run("explain", rec, "--mode", "ringdown", "--report", rep)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertNotIn("figures were not made", p.stderr)
+        for f in ("explain.json", "ringdown_envelope.csv", "ringdown_fit.csv",
+                  "ringdown_q_vs_amplitude.csv", "envelope.png", "residuals.png",
+                  "q_vs_amplitude.png", "report.md"):
+            self.assertGreater(os.path.getsize(os.path.join(rep, f)), 100, f)
+        with open(os.path.join(rep, "report.md")) as fh:
+            md = fh.read()
+        self.assertIn("gamma_nl", md)
+        self.assertIn("![envelope](envelope.png)", md)
+
 
 if __name__ == "__main__":
     unittest.main()

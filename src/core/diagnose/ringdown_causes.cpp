@@ -103,7 +103,7 @@ namespace {
 /// Blocked two-fold hold-out error of a model: the span's used samples in kHoldOutBlocks
 /// contiguous blocks, fitted on the even blocks and scored on the odd ones and back, started from
 /// the full fit. Returns the weighted squared prediction error over all samples (inf on failure).
-constexpr int kHoldOutBlocks = 16;
+constexpr int kHoldOutBlocks = 48;
 double holdOutError(const RingdownEnvelope& env, const RingdownSegment& seg,
                     const RingdownFit& full, const RingdownFitOptions& base) {
   std::vector<size_t> used;
@@ -151,9 +151,11 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
   const int nc = static_cast<int>(options.candidates.size());
   std::vector<RingdownFit> fits(nc);
   std::vector<bool> ok(nc, false);
-  // The effective sample size: n over the long-run variance factor of the best-fitting model's
-  // residuals (those closest to the noise), common to every criterion below.
-  double best_sse = x.baseline.sse_w, factor = x.baseline.long_run_factor;
+  // Likelihood under a common AR noise model (generalized least squares): the AR filter of the
+  // best-fitting model's residuals (those closest to the noise) whitens every model's weighted
+  // residuals, and the criterion is BIC on the whitened sum of squares, so that correlated noise
+  // neither counts as independent samples nor hides structure at the beat frequencies.
+  const RingdownFit* closest = &x.baseline;
   for (int k = 0; k < nc; ++k) {
     const std::string& c = options.candidates[k];
     try {
@@ -166,16 +168,29 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
       x.steps.push_back(s);
       continue;
     }
-    if (fits[k].sse_w < best_sse) best_sse = fits[k].sse_w, factor = fits[k].long_run_factor;
   }
-  const double n = x.baseline.n;
-  const double n_eff = std::max(8.0, n / std::max(1.0, factor));
-  // Information criterion (BIC on the effective sample size): IC = n_eff ln(SSE / n) + k
-  // ln(n_eff); the beat also pays for the searched split frequency (~n/4 candidates).
+  for (int k = 0; k < nc; ++k)
+    if (ok[k] && fits[k].sse_w < closest->sse_w) closest = &fits[k];
+  const std::vector<double> ar = closest->noise_ar;
+  auto whitenedSse = [&ar](const RingdownFit& f) {
+    const size_t m = f.t_s.size();
+    std::vector<double> e(m);
+    for (size_t i = 0; i < m; ++i)
+      e[i] = std::sqrt(f.weight[i]) * (f.log_amplitude[i] - f.fitted[i]);
+    double sse = 0.0;
+    for (size_t i = ar.size(); i < m; ++i) {
+      double w = e[i];
+      for (size_t k = 0; k < ar.size(); ++k) w -= ar[k] * e[i - 1 - k];
+      sse += w * w;
+    }
+    return sse;
+  };
+  const double n = static_cast<double>(x.baseline.n) - static_cast<double>(ar.size());
+  const double n_eff = n;
   auto ic = [&](const RingdownFit& f) {
-    double pen = f.n_params * std::log(n_eff);
+    double pen = f.n_params * std::log(n);
     if (f.model == "beat") pen += 2.0 * std::log(std::max(2.0, n / 4.0));
-    return n_eff * std::log(std::max(f.sse_w, 1e-300) / n) + pen;
+    return n * std::log(std::max(whitenedSse(f), 1e-300) / n) + pen;
   };
   const double ic_lin = ic(x.baseline);
   x.information_criterion["linear"] = ic_lin;
@@ -191,7 +206,7 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     s.sigma = f.sigma;
     s.sigma_ratio = x.baseline.sigma / std::max(f.sigma, 1e-300);
     s.lr_statistic =
-        n_eff * std::log(std::max(x.baseline.sse_w, 1e-300) / std::max(f.sse_w, 1e-300));
+        n * std::log(std::max(whitenedSse(x.baseline), 1e-300) / std::max(whitenedSse(f), 1e-300));
     s.information_criterion = ic(f);
     s.threshold = s.information_criterion - ic_lin + s.lr_statistic + options.margin;
     s.p_value = chi2Upper(f.n_params - 2, s.lr_statistic);

@@ -267,16 +267,26 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
     d.y(i) = env.log_amplitude[used[i]] - fit.log_a_ref;
   }
 
-  // Error model from differences in eight time bins: var = s_m^2 + s_a^2 exp(-2 level).
+  // Error model from the scatter about a local quadratic in eight time bins (not from
+  // sample-to-sample differences, which correlated detector noise makes small): var = s_m^2 +
+  // s_a^2 exp(-2 level).
   const int nb = std::max(2, std::min(8, n / 12));
   std::vector<double> var_k, lvl_k;
   for (int b = 0; b < nb; ++b) {
     const int lo = b * n / nb, hi = (b + 1) * n / nb;
+    if (hi - lo < 6) continue;
+    Eigen::MatrixXd Xq(hi - lo, 3);
+    Eigen::VectorXd Yq(hi - lo);
+    const double tm = 0.5 * (d.t(lo) + d.t(hi - 1)), th = std::max(d.t(hi - 1) - tm, 1e-12);
+    for (int i = lo; i < hi; ++i) {
+      const double u = (d.t(i) - tm) / th;
+      Xq(i - lo, 0) = 1.0, Xq(i - lo, 1) = u, Xq(i - lo, 2) = u * u, Yq(i - lo) = d.y(i);
+    }
+    const Eigen::VectorXd eq = Yq - Xq * Xq.colPivHouseholderQr().solve(Yq);
     std::vector<double> dd, lv;
-    for (int i = lo + 1; i < hi; ++i) dd.push_back(std::fabs(d.y(i) - d.y(i - 1)));
+    for (int i = 0; i < eq.size(); ++i) dd.push_back(std::fabs(eq(i)));
     for (int i = lo; i < hi; ++i) lv.push_back(d.y(i));
-    if (dd.size() < 3) continue;
-    const double s = 1.4826 * median(dd) / std::sqrt(2.0);
+    const double s = 1.4826 * median(dd);
     var_k.push_back(std::max(s * s, 1e-30));
     lvl_k.push_back(median(lv));
   }
@@ -405,6 +415,7 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
   fit.cov_crb = rc.crb;
   fit.cov_hac = rc.covariance;
   fit.noise_ar_order = static_cast<int>(rc.ar.size());
+  fit.noise_ar = rc.ar;
   fit.long_run_factor = rc.long_run_factor;
   fit.effective_n = rc.effective_n;
   fit.interval_method = rc.method + "; " + fit.error_model + " error model";

@@ -6,14 +6,17 @@
 #include <limits>
 #include <sstream>
 
+#include "cvg_bench/core/estimate/ringdown_models.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {
 
 constexpr double kDbPerNeper = 20.0 / 2.302585092994046;  // 20 / ln 10
-/// A floor: the tail lies this far above the decay's straight continuation [dB].
-constexpr double kFloorExcessDb = 5.0;
+/// A floor: the fitted floor lies this far above the decay's straight continuation at the end
+/// [dB], and the floor model beats the straight line by this evidence (n ln(SSE_0 / SSE_1)).
+constexpr double kFloorExcessDb = 3.0;
+constexpr double kFloorEvidence = 30.0;
 
 double median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -33,6 +36,74 @@ double slopeOver(const std::vector<double>& t, const std::vector<double>& y,
   Eigen::VectorXd Y(tt.size());
   for (size_t i = 0; i < tt.size(); ++i) X(i, 0) = 1.0, X(i, 1) = tt[i] - tt.front(), Y(i) = yy[i];
   return X.colPivHouseholderQr().solve(Y)(1);
+}
+
+struct FloorFit {
+  bool ok = false;
+  double floor_log = 0.0;  ///< ln of the floor's rms amplitude
+  double line_end = 0.0;   ///< the decay's straight continuation at the record's end (ln A)
+  double slope = 0.0;      ///< [1/s] of ln A
+  double evidence = 0.0;   ///< n ln(SSE_line / SSE_floor)
+};
+
+/// Fits ln A from sample a to the end with a straight decay plus an additive floor (the Rice mean
+/// of ringdown_models.h) and with the straight decay alone, by Gauss-Newton on at most 600
+/// samples (QR of the Jacobian).
+FloorFit fitFloor(const std::vector<double>& t, const std::vector<double>& y,
+                  const std::vector<bool>& skip, size_t a, double ref) {
+  FloorFit out;
+  const size_t n = t.size();
+  const size_t stride = std::max<size_t>(1, (n - a) / 600);
+  std::vector<double> u, v;
+  const double t0 = t[a], ts = std::max(t.back() - t[a], 1e-300);
+  for (size_t i = a; i < n; i += stride)
+    if (!skip[i] && std::isfinite(y[i])) u.push_back((t[i] - t0) / ts), v.push_back(y[i] - ref);
+  const int m = static_cast<int>(u.size());
+  if (m < 12) return out;
+  Eigen::MatrixXd X(m, 2);
+  Eigen::VectorXd Y(m);
+  for (int i = 0; i < m; ++i) X(i, 0) = 1.0, X(i, 1) = -u[i], Y(i) = v[i];
+  const Eigen::VectorXd line = X.colPivHouseholderQr().solve(Y);
+  const double sse0 = (Y - X * line).squaredNorm();
+  auto resid = [&](const Eigen::Vector3d& p, Eigen::VectorXd& r) {
+    r.resize(m);
+    Eigen::VectorXd q(2);
+    q << p(0), p(1);
+    for (int i = 0; i < m; ++i)
+      r(i) = v[i] - ringdownLogAmplitude("linear", q, u[i], std::exp(p(2)));
+    return r.allFinite();
+  };
+  Eigen::Vector3d p(line(0), line(1), 0.2);  // floor near the tail's level
+  Eigen::VectorXd r, rp;
+  if (!resid(p, r)) return out;
+  double sse = r.squaredNorm();
+  for (int it = 0; it < 40; ++it) {
+    Eigen::MatrixXd J(m, 3);
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector3d pp = p;
+      pp(k) += 1e-6;
+      if (!resid(pp, rp)) return out;
+      J.col(k) = (r - rp) / 1e-6;
+    }
+    const Eigen::Vector3d step = J.colPivHouseholderQr().solve(r);
+    double lam = 1.0;
+    bool moved = false, done = false;
+    for (int h = 0; h < 12 && !moved; ++h, lam *= 0.5) {
+      Eigen::Vector3d pn = p + lam * step;
+      pn(2) = std::max(pn(2), -20.0);
+      if (resid(pn, rp) && rp.squaredNorm() < sse) {
+        done = (sse - rp.squaredNorm()) / sse < 1e-9;
+        p = pn, r = rp, sse = rp.squaredNorm(), moved = true;
+      }
+    }
+    if (!moved || done) break;
+  }
+  out.ok = true;
+  out.floor_log = ref + p(2);
+  out.slope = -p(1) / ts;
+  out.line_end = ref + p(0) - p(1);
+  out.evidence = m * std::log(std::max(sse0, 1e-300) / std::max(sse, 1e-300));
+  return out;
 }
 
 }  // namespace
@@ -105,8 +176,8 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     if (std::isfinite(sm[i])) idx.push_back(i);
   if (idx.size() < 8) throw AnalysisError("ring-down: fewer than 8 usable envelope samples");
 
-  // 2. Noise floor: the record's last tenth lies well above the straight continuation of the decay
-  // (fitted on the decay's last stretch above that tail level), which a pure decay does not.
+  // 2. Noise floor: from 25 dB above the level of the record's last tenth to the end, a straight
+  // decay plus an additive floor beats the straight decay, with the floor above its continuation.
   const size_t tail_a = n - std::max<size_t>(4, n / 10);
   double peak_sm = -std::numeric_limits<double>::infinity();
   size_t i_peak = 0;
@@ -131,30 +202,13 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
         break;
       }
     }
-    const double excess_min = kFloorExcessDb / kDbPerNeper;
     if (total > (options.floor_margin_db + options.min_decay_db) / kDbPerNeper && a < n && b < n &&
         b > a + 4) {
-      const double slope = slopeOver(t, sm, seg.dropout, a, b);
-      double level_a = 0.0;  // the line through the stretch's mean
-      double t_mean = 0.0;
-      int cnt = 0;
-      for (size_t i = a; i < b; ++i)
-        if (!seg.dropout[i] && std::isfinite(sm[i])) level_a += sm[i], t_mean += t[i], ++cnt;
-      level_a /= std::max(1, cnt), t_mean /= std::max(1, cnt);
-      const double t_tail = 0.5 * (t[tail_a] + t.back());
-      const double extrapolated = level_a + slope * (t_tail - t_mean);
-      if (slope < 0.0 && tail_level - extrapolated > excess_min) {
-        // Floor power: the tail's mean power less the decay's continuation.
-        double pow_sum = 0.0;
-        size_t c = 0;
-        for (size_t i = tail_a; i < n; ++i) {
-          if (seg.dropout[i] || !std::isfinite(y[i])) continue;
-          const double line = level_a + slope * (t[i] - t_mean);
-          pow_sum += std::exp(2.0 * (y[i] - tail_level)) - std::exp(2.0 * (line - tail_level));
-          ++c;
-        }
-        const double floor_log =
-            tail_level + 0.5 * std::log(std::max(pow_sum / std::max<size_t>(1, c), 1e-6));
+      const FloorFit ff = fitFloor(t, y, seg.dropout, a, tail_level);
+      const double excess = ff.floor_log - ff.line_end;
+      if (ff.ok && ff.slope < 0.0 && ff.evidence > kFloorEvidence &&
+          excess > kFloorExcessDb / kDbPerNeper) {
+        const double floor_log = ff.floor_log;
         seg.has_floor = true;
         seg.floor_log_amplitude = floor_log;
         const double cut = floor_log + options.floor_margin_db / kDbPerNeper;
@@ -197,6 +251,30 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
   seg.plateau_log_amplitude = c0;
   const double best_c = c0;
   size_t i_start = seg.has_plateau ? i_cross : 0;
+  // Detector settling: a lock-in or video filter rounds the corner at switch-off, so the decay rate
+  // starts near zero. The span starts where the local rate (over w samples) first reaches 90 % of
+  // the rate between 3 and 13 dB below the start (at most the first 3 dB of decay are skipped;
+  // damping that grows with amplitude makes the early rate higher, so nothing is skipped then).
+  if (i_end > i_start + 40) {
+    const double s0 = sm[i_start];
+    size_t a3 = i_end, a13 = i_end;
+    for (size_t i = i_start; i < i_end; ++i) {
+      if (!std::isfinite(sm[i])) continue;
+      if (a3 == i_end && sm[i] <= s0 - 3.0 / kDbPerNeper) a3 = i;
+      if (sm[i] <= s0 - 13.0 / kDbPerNeper) {
+        a13 = i;
+        break;
+      }
+    }
+    if (a3 < i_end && a13 > a3 + 8) {
+      const double ref = slopeOver(t, sm, seg.dropout, a3, a13);
+      const size_t w = std::max<size_t>(8, n / 200);
+      for (size_t i = i_start; i + w < a3; ++i) {
+        if (slopeOver(t, sm, seg.dropout, i, i + w) <= 0.9 * ref) break;
+        i_start = i + 1;
+      }
+    }
+  }
   if (i_end <= i_start + 8) throw AnalysisError("ring-down: no decay above the noise floor");
   seg.i_start = i_start;
   seg.i_end = i_end;

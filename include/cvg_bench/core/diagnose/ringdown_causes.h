@@ -29,9 +29,9 @@ namespace cvg_bench {
 
 struct RingdownExplainOptions {
   /// Level of the lack-of-fit test, (0, 0.2].
-  double alpha = 0.001;
+  double alpha = 1e-5;
   /// An extension's information criterion must lie this far below the single exponential's.
-  double margin = 10.0;
+  double margin = 20.0;
   /// A beat or two-stage decay must lie this far below every physical amplitude law.
   double law_margin = 10.0;
   /// Candidate extensions tried (ringdownExtensionNames() by default).

@@ -2,10 +2,11 @@
 // with the models of ringdown_models.h, in normalized units (scale-free), by weighted nonlinear
 // least squares on ln A (Levenberg-Marquardt, QR of the weighted Jacobian).
 //
-// Error model, chosen from the data: the sd of ln A, measured from sample-to-sample differences in
-// eight time bins of the span, is fitted as s^2 = s_m^2 + s_a^2 / A'^2. A constant s (s_m term)
-// is noise on the log/dB scale (relative noise); a growth as 1/A is additive noise on the amplitude
-// (with the floor). The weights are 1 / s^2 at each sample's fitted level either way.
+// Error model, chosen from the data: the sd of ln A, measured as the robust scatter about a local
+// quadratic in eight time bins of the span (correlated detector noise hides in differences), is
+// fitted as s^2 = s_m^2 + s_a^2 / A'^2. A constant s (s_m term) is noise on the log/dB scale
+// (relative noise); a growth as 1/A is additive noise on the amplitude (with the floor). The
+// weights are 1 / s^2 at each sample's fitted level either way.
 //
 // Intervals: ringdown_intervals.h (serial correlation detected in the weighted ln A residuals ->
 // sandwich under an AR(p) noise model, else white), which stays honest when the residuals are
@@ -70,6 +71,7 @@ struct RingdownFit {
   double rms_log = 0.0;          ///< rms residual of ln A [Np]
   double rho1 = 0.0;             ///< lag-1 autocorrelation of the residuals
   int noise_ar_order = 0;        ///< AR order of the residual noise model (0: white)
+  std::vector<double> noise_ar;  ///< its coefficients a_1..a_p
   double long_run_factor = 1.0;  ///< its long-run variance factor 1 + 2 sum rho_l
   double effective_n = 0.0;      ///< n / long_run_factor
   bool converged = false;

@@ -2,12 +2,16 @@
 // floor, with drop-outs marked, so that only the decay above the floor is fitted.
 //  1. Drop-outs: non-finite samples, and samples more than max(8 robust sd, 3 dB) below the running
 //     median of their neighbours (a detector that lost lock, a spectrum-analyser blank).
-//  2. Noise floor: the median level of the record's last tenth lies 5 dB or more above the straight
-//     continuation of the decay (fitted from 25 to 10 dB above that level): floor = rms amplitude
-//     of that tail less the continuation's power; the decay span ends where the running median
-//     falls to `floor_margin_db` above the floor (the fit includes the floor as an additive power).
+//  2. Noise floor: from 25 dB above the median level of the record's last tenth to the end, a
+//     straight ln A decay plus an additive floor (the Rice mean of ringdown_models.h) is fitted
+//     against the straight decay alone; a floor when it wins (n ln(SSE ratio) > 30) and lies 3 dB
+//     or more above the line's continuation at the end. The decay span ends where the running
+//     median falls to `floor_margin_db` above the floor (the fit includes the floor).
 //  3. Drive switch-off: a hinge (constant, then a straight decline of ln A) fitted by QR on a grid
 //     of switch-off times; the span starts one median interval after the hinge.
+//     Detector settling: the span then starts where the local decay rate first reaches 90 % of the
+//     rate between 3 and 13 dB below the start (a lock-in's low-pass rounds the corner; at most
+//     the first 3 dB are skipped).
 //  4. Refusal: under 3 dB (or 10 robust sd) of decay, or under 8 samples in the span.
 #pragma once
 
