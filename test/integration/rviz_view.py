@@ -114,8 +114,12 @@ class RvizView(unittest.TestCase):
                 dump = os.path.join(tmp, "root.xwd")
                 while True:
                     self.assertIsNone(rviz.poll(), "rviz exited")
-                    subprocess.run(["xwd", "-root", "-silent", "-out", dump], env=env, check=True,
-                                   timeout=10)
+                    # xwd can fail while Xvfb or rviz's window is still coming up: retry.
+                    if subprocess.run(["xwd", "-root", "-silent", "-out", dump], env=env,
+                                      timeout=10).returncode != 0:
+                        self.assertLess(time.monotonic(), deadline, "xwd kept failing")
+                        time.sleep(2.0)  # screenshot period of the bounded wait
+                        continue
                     rgb = read_xwd(dump)
                     counts = colour_counts(rgb)
                     if all(counts[k] >= v for k, v in MIN_PIXELS.items()):
