@@ -5,6 +5,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "cvg_bench/core/diagnose/low_frequency_misfit.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
@@ -190,19 +191,31 @@ Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
   } else {
     Eigen::VectorXd e(4 * adequacy.size());
     for (size_t i = 0; i < adequacy.size(); ++i) e.segment<4>(4 * i) = adequacy[i].e;
-    x.noise_model = noiseModelFromResiduals(e, 4);
+    x.noise_model = noiseModelFromDetrendedResiduals(e, 4);
   }
   x.final_signature = residualSignature(whitenBlocks(x.final_blocks, x.noise_model), mode, stride,
                                         options.signature_bins);
-  x.lack_of_fit = lackOfFit(mode, whitenBlocks(adequacy, x.noise_model));
-  x.lack_of_fit.noise_model = x.noise_model.description;
-  x.lack_of_fit.p_value_unwhitened = lackOfFit(mode, adequacy).p_value;
+  LackOfFit& lof = x.lack_of_fit;
+  lof = lackOfFit(mode, whitenBlocks(adequacy, x.noise_model));
+  lof.runs_p_value = lof.p_value;
+  lof.noise_model = x.noise_model.description;
+  lof.p_value_unwhitened = lackOfFit(mode, adequacy).p_value;
   const ResidualSignature& fs = x.final_signature;
-  bool structured = false;
   for (const auto& e : fs.entries)
-    if (e.p_value < options.lack_of_fit_alpha / std::max<size_t>(1, fs.entries.size()))
-      structured = true;
-  x.unexplained = x.lack_of_fit.p_value < options.lack_of_fit_alpha || structured;
+    lof.signature_p_value = std::min(
+        lof.signature_p_value, std::min(1.0, e.p_value * std::max<size_t>(1, fs.entries.size())));
+  if (mode == ExperimentMode::kFreeDecay) {
+    // The structured test: a smooth component the (known + fitted) noise model cannot make.
+    const ResidualNoiseModel known_model =
+        known.empty() ? ResidualNoiseModel() : noiseModelFromCorrelation(known);
+    const LowFrequencyMisfitTest lf = lowFrequencyMisfit(adequacy, known_model);
+    lof.low_frequency_p_value = lf.p_value;
+    lof.low_frequency = lf.worst;
+    lof.test += "; " + lf.description + "; Bonferroni over the two tests";
+    lof.p_value = std::min(1.0, 2.0 * std::min(lof.runs_p_value, lf.p_value));
+  }
+  x.unexplained =
+      lof.p_value < options.lack_of_fit_alpha || lof.signature_p_value < options.lack_of_fit_alpha;
   x.notes.push_back("hold-out: " + x.selection.holdout_description);
   x.notes.push_back("adequacy noise model: " + x.noise_model.description);
   x.cause = verdict(x, mode, options);

@@ -55,7 +55,12 @@ struct LackOfFit {
   double p_value = 1.0;     ///< Bonferroni-combined p-value (residuals whitened by the noise model)
   std::string worst;        ///< the sequence with the fewest runs relative to expectation
   std::string noise_model;  ///< the whitening noise model, in words
-  double p_value_unwhitened = 1.0;  ///< the same test on the raw residuals (for comparison)
+  double p_value_unwhitened = 1.0;     ///< the same test on the raw residuals (for comparison)
+  double runs_p_value = 1.0;           ///< the whitened runs test alone
+  double low_frequency_p_value = 1.0;  ///< free decay: low_frequency_misfit.h (1 in forced mode)
+  std::string low_frequency;           ///< that test's worst sequence, in words
+  double signature_p_value =
+      1.0;  ///< smallest final-signature p-value times the entries (Bonferroni)
 };
 
 struct Explanation {

@@ -35,6 +35,15 @@ ResidualNoiseModel noiseModelFromCorrelation(const std::vector<double>& rho, int
 ResidualNoiseModel noiseModelFromResiduals(const Eigen::VectorXd& residuals, int channels,
                                            double min_rho = 0.05);
 
+/// AR(1) of each channel's residuals after a least-squares fit of Legendre polynomials of degree
+/// <= `degree` in the sample index is removed (a smooth misfit has lag-1 correlation ~1 and would
+/// otherwise pass for correlated noise), Yule-Walker rho averaged over the channels, capped at
+/// `ceiling` (a correlation time beyond ~1 / (1 - ceiling) samples is not told from a misfit on one
+/// record); white when |rho| < min_rho.
+ResidualNoiseModel noiseModelFromDetrendedResiduals(const Eigen::VectorXd& residuals, int channels,
+                                                    int degree = 5, double ceiling = 0.95,
+                                                    double min_rho = 0.05);
+
 /// Applies the whitening filter to each channel (the first p samples of a channel use the
 /// available past only).
 Eigen::VectorXd whiten(const Eigen::VectorXd& residuals, int channels,
