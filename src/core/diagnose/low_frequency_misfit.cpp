@@ -1,11 +1,13 @@
 #include "cvg_bench/core/diagnose/low_frequency_misfit.h"
 
+#include <Eigen/Dense>
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "cvg_bench/core/diagnose/model_diagnosis.h"
+#include "cvg_bench/core/estimate/fitted_residual_ar1.h"
 
 namespace cvg_bench {
 namespace {
@@ -59,12 +61,22 @@ double lowFrequencyPValue(const std::vector<double>& x, const std::vector<double
   Eigen::MatrixXd b = legendreBasis(t, k - 1);
   y = knownWhitened(y, known);
   for (int j = 0; j < k; ++j) b.col(j) = knownWhitened(b.col(j), known);
+  // The first p filtered values lack their full past (not whitened): conditional on them.
+  const long skip = static_cast<long>(known.ar.size());
+  if (n - skip < 4 * k) return 1.0;
+  y = y.tail(n - skip).eval();
+  b = b.bottomRows(n - skip).eval();
   // AR(1) of what the smooth basis leaves (Yule-Walker lag-1 correlation).
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(b);
   const Eigen::VectorXd u = y - b * qr.solve(y);
+  const long m = y.size();
   const double c0 = u.squaredNorm();
-  double rho = c0 > 0.0 ? u.head(n - 1).dot(u.tail(n - 1)) / c0 : 0.0;
-  rho = std::max(-0.5, rho);
+  double rho = c0 > 0.0 ? u.head(m - 1).dot(u.tail(m - 1)) / c0 : 0.0;
+  // Removing the smooth part removes slow noise too: the lag-1 correlation of u understates
+  // rho; corrected by its expectation under that projection (fitted_residual_ar1.h).
+  const Eigen::MatrixXd gram_inv =
+      (b.transpose() * b).completeOrthogonalDecomposition().pseudoInverse();
+  rho = std::max(-0.5, fittedResidualAr1(b, gram_inv, 1, rho));
   if (rho > options.rho_ceiling) {
     rho = options.rho_ceiling;
     if (capped) *capped = true;
@@ -76,9 +88,9 @@ double lowFrequencyPValue(const std::vector<double>& x, const std::vector<double
   const double rss0 = w.squaredNorm();
   const double rss1 = (w - wb * wqr.solve(w)).squaredNorm();
   const int rank = static_cast<int>(wqr.rank());
-  if (!(rss1 > 0.0) || rank < 1 || n - rank < 1) return rss0 > 0.0 ? 0.0 : 1.0;
-  const double f = ((rss0 - rss1) / rank) / (rss1 / static_cast<double>(n - rank));
-  return fUpperTail(f, rank, static_cast<int>(n - rank));
+  if (!(rss1 > 0.0) || rank < 1 || m - rank < 1) return rss0 > 0.0 ? 0.0 : 1.0;
+  const double f = ((rss0 - rss1) / rank) / (rss1 / static_cast<double>(m - rank));
+  return fUpperTail(f, rank, static_cast<int>(m - rank));
 }
 
 LowFrequencyMisfitTest lowFrequencyMisfit(const std::vector<BlockResidual>& blocks,

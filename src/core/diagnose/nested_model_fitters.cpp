@@ -46,8 +46,7 @@ NestedFit residualsOnly(const StackedSystem& sys, const std::vector<std::string>
   f.model = sys.model;
   const Eigen::VectorXd norms = sys.d.colwise().norm().transpose().cwiseMax(1e-300);
   const Eigen::MatrixXd scaled = sys.d * norms.cwiseInverse().asDiagonal();
-  const Eigen::VectorXd z =
-      scaled.colPivHouseholderQr().solve(sys.y).cwiseQuotient(norms);
+  const Eigen::VectorXd z = scaled.colPivHouseholderQr().solve(sys.y).cwiseQuotient(norms);
   f.residuals = sys.y - sys.d * z;
   f.rss = f.residuals.squaredNorm();
   f.n_equations = static_cast<long>(sys.y.size());

@@ -1,9 +1,12 @@
 #include "cvg_bench/core/diagnose/residual_noise_model.h"
 
+#include <Eigen/Dense>
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+
+#include "cvg_bench/core/estimate/fitted_residual_ar1.h"
 
 namespace cvg_bench {
 namespace {
@@ -103,6 +106,20 @@ ResidualNoiseModel noiseModelFromDetrendedResiduals(const Eigen::VectorXd& resid
     }
   }
   double rho = c0 > 0.0 ? std::max(-0.5, c1 / c0) : 0.0;
+  if (c0 > 0.0) {
+    // The smooth part takes slow noise with it: lag-1 correlation corrected for the projection.
+    Eigen::MatrixXd b(n, degree + 1);
+    for (long i = 0; i < n; ++i) {
+      const double s = n > 1 ? 2.0 * i / (n - 1.0) - 1.0 : 0.0;
+      b(i, 0) = 1.0;
+      if (degree >= 1) b(i, 1) = s;
+      for (int k = 1; k < degree; ++k)
+        b(i, k + 1) = ((2.0 * k + 1.0) * s * b(i, k) - k * b(i, k - 1)) / (k + 1.0);
+    }
+    const Eigen::MatrixXd gram_inv =
+        (b.transpose() * b).completeOrthogonalDecomposition().pseudoInverse();
+    rho = std::max(-0.5, fittedResidualAr1(b, gram_inv, 1, rho));
+  }
   const bool capped = rho > ceiling;
   rho = std::min(rho, ceiling);
   if (std::abs(rho) < min_rho) {

@@ -10,6 +10,7 @@
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/collinearity.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/estimate/fitted_residual_ar1.h"
 #include "cvg_bench/core/estimate/hac_covariance.h"
 #include "cvg_bench/core/estimate/identifiability.h"
 #include "cvg_bench/core/estimate/output_error_forced.h"
@@ -245,11 +246,14 @@ CeresCovariance outputErrorCovariance(const FittedProblem& fp, const AtSolution&
       // A noise model: AR(1) on each slow variable with rho = the residuals' lag-1 correlation
       // (rho_l = rho^l kept while > 1e-3). Under AR(1) rho = 0.9 this holds 95 % coverage where
       // the HAC sandwich on ~10^3 samples gives ~0.90 (correlated_intervals_test).
+      // The fit removes mostly slow noise, so the residuals' lag-1 correlation understates rho:
+      // corrected by its expectation under the fit (fitted_residual_ar1.h).
       rho.clear();
-      const double r1 = std::min(test.lag1, 0.995);
+      const double r1 = std::min(fittedResidualAr1(a.j, unscaled, 4, test.lag1), 0.995);
       for (double v = r1; v > 1e-3 && static_cast<long>(rho.size()) < n / 8; v *= r1)
         rho.push_back(v);
-      source = "AR(1) fitted to the residuals' lag-1 correlation";
+      source = "AR(1) fitted to the residuals' lag-1 correlation " + fmt3(test.lag1) +
+               " (corrected for the fit)";
       id = "ar1_fitted";
     } else if (n / 4 > 3 * a.j.cols()) {
       const HacCovariance hac = hacCovarianceBlocked(a.j, a.residuals, 4);
