@@ -133,13 +133,16 @@ std::string verdict(const Explanation& x, ExperimentMode mode, const ExplainOpti
     o << " Runner-up: " << sel.runner_up.model << ", criterion " << num(sel.runner_up_delta, 3)
       << (sel.runner_up_delta >= 0 ? " worse" : " better but not confirmed by the hold-out") << ".";
   if (x.unexplained) {
+    const LackOfFit& l = x.lack_of_fit;
+    const bool slow = l.low_frequency_p_value < l.runs_p_value;
     o << " Systematic structure remains that no candidate removes: "
-      << x.final_signature.describe(options.lack_of_fit_alpha) << "; lack of fit "
-      << pText(x.lack_of_fit.p_value) << " (" << x.lack_of_fit.worst
-      << "). Look for an effect outside the library.";
+      << (slow ? "a slowly varying misfit of the trajectory residuals (" + l.low_frequency + ")"
+               : x.final_signature.describe(options.lack_of_fit_alpha) + " (" + l.worst + ")")
+      << "; lack of fit " << pText(l.p_value) << " under the noise model "
+      << x.noise_model.description << ". Look for an effect outside the library.";
   } else {
-    o << " The " << (sel.selected.empty() ? "linear" : "final") << " model is adequate (runs test "
-      << pText(x.lack_of_fit.p_value) << ").";
+    o << " The " << (sel.selected.empty() ? "linear" : "final")
+      << " model is adequate (lack of fit " << pText(x.lack_of_fit.p_value) << ").";
   }
   return o.str();
 }

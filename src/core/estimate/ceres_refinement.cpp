@@ -325,20 +325,13 @@ void fillIdentifiability(const FittedProblem& fp, const AtSolution& a, const Ran
                      "): intervals of the unidentifiable parameters are not meaningful");
 }
 
-/// Rank, covariance, intervals, identifiability and derived quantities of the fitted problem.
-void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estimate* e) {
-  const AtSolution a = evaluateAtSolution(fp);
+/// The reported parameters' values, covariance and Student-t intervals (dof = n - rank).
+void fillIntervals(const FittedProblem& fp, const AtSolution& a, const RankAnalysis& r,
+                   const CeresCovariance& cc, const CeresOptions& options, double s_p,
+                   Estimate* e) {
   const int n = static_cast<int>(a.j.rows()), p = static_cast<int>(a.j.cols());
-  const RankAnalysis r = numericalRank(a.j, options.rank_tolerance);
-  const int dof = n - r.rank;
-  if (dof < 1)
-    throw AnalysisError("Ceres refinement: no degrees of freedom left (" + std::to_string(n) +
-                        " residuals, rank " + std::to_string(r.rank) + ")");
-  const Eigen::MatrixXd unscaled = unscaledCovariance(fp, a, r, options, e);
-  const CeresCovariance cc = outputErrorCovariance(fp, a, unscaled, dof, e);
-
   const int k = fp.n_reported;
-  const double s_p = studentQuantile(options.confidence, dof);
+  const int dof = n - r.rank;
   e->method = "ceres";
   e->n_equations = n;
   e->n_params = k;
@@ -358,6 +351,22 @@ void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estima
   e->parameters_paper.clear();
   e->singular_values.assign(r.s.data(), r.s.data() + r.s.size());
   e->rank_tolerance = options.rank_tolerance;
+}
+
+/// Rank, covariance (outputErrorCovariance), intervals (fillIntervals), identifiability and
+/// derived quantities of the fitted problem.
+void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estimate* e) {
+  const AtSolution a = evaluateAtSolution(fp);
+  const int n = static_cast<int>(a.j.rows());
+  const RankAnalysis r = numericalRank(a.j, options.rank_tolerance);
+  const int dof = n - r.rank;
+  if (dof < 1)
+    throw AnalysisError("Ceres refinement: no degrees of freedom left (" + std::to_string(n) +
+                        " residuals, rank " + std::to_string(r.rank) + ")");
+  const Eigen::MatrixXd unscaled = unscaledCovariance(fp, a, r, options, e);
+  const CeresCovariance cc = outputErrorCovariance(fp, a, unscaled, dof, e);
+  const double s_p = studentQuantile(options.confidence, dof);
+  fillIntervals(fp, a, r, cc, options, s_p, e);
   fillIdentifiability(fp, a, r, cc.cov, s_p, e);
   e->derived.clear();
   e->derived_method.clear();
