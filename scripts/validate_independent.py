@@ -586,6 +586,7 @@ def load_runs(args):
         kinds += [k for k in d["kinds"] if k not in kinds]
         terms = d.get("library_terms_beyond_ten", []) if terms is None else terms
         args.tool_commit = d.get("tool", "?")
+        args.parts = getattr(args, "parts", []) + [",".join(d["kinds"])]
         gen += d.get("gen_cpu_s", 0.0)
     args.terms, args.gen_cpu = terms or [], gen
     args.kinds = ",".join(k for k in KINDS if k in kinds)
@@ -798,10 +799,13 @@ def report_header(args, elapsed, n):
             "that it names: %s)." % (
                 time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), " --quick" if args.quick else "",
                 (" --coverage-runs %d" % args.coverage_runs if args.coverage_runs != 60 else "")
-                + (" --thin %d (fd_slow)" % args.thin if args.thin > 1 else ""),
+                + (" --thin %d" % args.thin if args.thin > 1 else ""),
                 "" if args.kinds == ",".join(KINDS) else " --kinds " + args.kinds, n, elapsed,
                 args.jobs, getattr(args, "tool_commit", None) or tool_version(args.tool),
                 ", ".join(args.terms) or "none"),
+            ] + ([("Assembled by --from-json from separate runs of the same command with "
+                   "--kinds %s (each --jobs 1)." % "; --kinds ".join(args.parts))]
+                 if getattr(args, "parts", None) else []) + [
             "", "Cost: the tool's CPU time (user + system, summed over runs) %.0f s, i.e. %.1f min "
             "on %d unloaded cores; generator %.0f s (CPU, cached trajectories not counted). "
             "Wall time depends on the machine's load." % (
