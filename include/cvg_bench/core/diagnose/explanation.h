@@ -5,7 +5,9 @@
 // Steps: (1) fit the linear baseline and read its residual signature (residual_signature.h);
 // (2) best-subset selection over the candidate extensions (forward_selection.h) with the gain of
 // every step and the runner-up; (3) lack-of-fit test of the final model, its residuals whitened
-// by the noise model of residual_noise_model.h (known demodulator correlation or AR(1)):
+// by the noise model of residual_noise_model.h (known demodulator correlation, else AR(1) fitted
+// after the smooth part is removed); in free decay also the low-frequency GLS test of
+// low_frequency_misfit.h, Bonferroni with the runs test:
 //   forced sweep: Wald-Wolfowitz runs test of the per-point residuals ordered by drive frequency
 //     (points do not share samples, so they are independent under an adequate model), on the
 //     radial and tangential projections and the 4 components, Bonferroni over the 6 sequences;
@@ -15,8 +17,7 @@
 //     residuals are the measurement noise itself under an adequate model. Decimated to ~200
 //     values per sequence;
 // (4) the verdict in words: cause, parameter with CI, gain; `unexplained` when the final model
-// still fails the lack-of-fit test or keeps a significant residual signature (of the whitened
-// equation residuals).
+// still fails the lack-of-fit test (forced sweeps: or keeps a significant residual signature).
 // The ROS identifier node's Explain service and the tool's `explain` subcommand both call
 // explainFreeDecay / explainForced.
 #pragma once

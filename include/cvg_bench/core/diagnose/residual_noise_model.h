@@ -8,10 +8,13 @@
 // before the runs test and the signature:
 //   known correlation rho_1..rho_L (a demodulated record's noise_correlation): AR(p) by
 //     Levinson-Durbin on rho (p = min(L, 30));
-//   otherwise AR(1) with rho from the variogram ratio
+//   otherwise AR(1) of the residuals after a smooth part (Legendre polynomials in time) is removed,
+//   its lag-1 correlation corrected for that projection and capped at 0.95
+//   (noiseModelFromDetrendedResiduals, used by explain). The older variogram-ratio estimate
 //     rho = (1 - r_2) / (1 - r_1) - 1,   r_l the lag-l residual autocorrelation,
-//   which a slowly varying misfit s (s_t ~ s_{t-1} ~ s_{t-2}) leaves unchanged, unlike r_1 itself:
-//   a missing effect is not mistaken for correlated noise and whitened away.
+//   (noiseModelFromResiduals) is fooled by a curved misfit larger than the noise: its increments
+//   grow as l^2, the ratio tends to 4 and rho to its clamp, whitening the misfit away (the
+//   Foucault record, docs/examples/foucault.md).
 // A smooth misfit passes the filter scaled by (1 - sum a_k), so it stays visible to the tests.
 #pragma once
 
