@@ -90,7 +90,11 @@ nlohmann::json explanationToJson(const Explanation& x) {
                       {"p_value", x.lack_of_fit.p_value},
                       {"worst", x.lack_of_fit.worst},
                       {"noise_model", x.lack_of_fit.noise_model},
-                      {"p_value_unwhitened", x.lack_of_fit.p_value_unwhitened}};
+                      {"p_value_unwhitened", x.lack_of_fit.p_value_unwhitened},
+                      {"runs_p_value", x.lack_of_fit.runs_p_value},
+                      {"low_frequency_p_value", x.lack_of_fit.low_frequency_p_value},
+                      {"low_frequency", x.lack_of_fit.low_frequency},
+                      {"signature_p_value", x.lack_of_fit.signature_p_value}};
   j["cause"] = x.cause;
   nlohmann::json rejected = nlohmann::json::array();
   for (const auto& s : x.selection.last_round) rejected.push_back(stepToJson(s));

@@ -65,13 +65,17 @@ class FoucaultExample(unittest.TestCase):
         self.assertAlmostEqual(self.s["r_px"]["end"], 183.1, delta=0.1)
 
     def test_explain_verdict_today(self):
-        # Pinned: best-subset selection picks xi + cm_rate + kappa and calls it adequate because the
-        # AR(1) whitening (rho ~0.98) absorbs the slow misfit (the unwhitened runs test rejects);
-        # docs/examples/foucault.md says why that verdict is not trusted. Update both together.
+        # Pinned: best-subset selection picks xi + cm_rate + kappa and the adequacy test rejects it:
+        # the AR(1) noise model fitted after the slow part is removed has rho ~0.79 (not the 0.98
+        # that whitened the misfit away before), and the low-frequency GLS test finds the slow
+        # misfit. docs/examples/foucault.md quotes these; update both together.
         e = self.s["explain"]
         self.assertEqual(sorted(e["selected"]), ["cm_rate", "kappa", "xi"])
-        self.assertFalse(e["unexplained"])
-        self.assertLess(e["lack_of_fit"]["p_value_unwhitened"], 1e-6)
+        self.assertTrue(e["unexplained"])
+        lof = e["lack_of_fit"]
+        self.assertLess(lof["p_value_unwhitened"], 1e-6)
+        self.assertLess(lof["low_frequency_p_value"], 1e-15)
+        self.assertIn("rho = 0.79", lof["noise_model"])
         self.assertAlmostEqual(e["baseline"]["sigma"], 7.51, delta=0.01)
         self.assertAlmostEqual(e["steps"][0]["sigma"], 0.714, delta=0.002)
         self.assertAlmostEqual(e["steps"][1]["sigma"], 0.542, delta=0.002)
@@ -87,16 +91,16 @@ class FoucaultExample(unittest.TestCase):
         self.check(xi["parameters"]["xi"], -6.47e-7, -6.70e-7, -6.23e-7)
         self.check(xi["phi_rate_k0_deg_h"], 1.79, 1.24, 2.33, rel=0.02)
         self.check(xi["phi_rate_deg_h"], 3.81, 3.30, 4.32, rel=0.01)
-        self.check(self.s["ladder"]["xi (ceres)"]["phi_rate_k0_deg_h"], 1.28, -1.42, 3.97, rel=0.03)
+        self.check(self.s["ladder"]["xi (ceres)"]["phi_rate_k0_deg_h"], 1.28, -2.07, 4.62, rel=0.03)
 
     def test_extended_model(self):
         ls, ce = self.s["ladder"]["xi+xi_k"], self.s["ladder"]["xi+xi_k (ceres)"]
         self.check(ls["precession_coupling"], 9.36e-7, 1.59e-7, 17.12e-7, rel=0.01)
-        self.check(ce["precession_coupling"], 2.26e-6, 1.25e-6, 3.27e-6, rel=0.01)
+        self.check(ce["precession_coupling"], 2.26e-6, 1.15e-6, 3.37e-6, rel=0.01)
         self.check(ls["phi_rate_k0_deg_h"], 8.81, 5.47, 12.15, rel=0.005)
-        self.check(ce["phi_rate_k0_deg_h"], 12.93, 5.73, 20.12, rel=0.01)
+        self.check(ce["phi_rate_k0_deg_h"], 12.93, 4.89, 20.97, rel=0.01)
         self.check(ls["phi_rate_deg_h"], 5.02, 4.27, 5.77, rel=0.01)
-        self.check(ce["phi_rate_deg_h"], 4.24, -1.32, 9.80, rel=0.02)
+        self.check(ce["phi_rate_deg_h"], 4.24, -1.99, 10.48, rel=0.02)
         self.assertAlmostEqual(self.s["ladder"]["xi (ceres)"]["sigma"], 0.714, delta=0.002)
         self.assertAlmostEqual(ce["sigma"], 0.529, delta=0.002)
         self.assertAlmostEqual(self.s["physics"]["sigma_gain_over_paper_cubic_ceres"], 1.35,
@@ -114,7 +118,7 @@ class FoucaultExample(unittest.TestCase):
         self.assertAlmostEqual(self.s["Q_envelope_record"], 4970, delta=10)
         ce = self.s["ladder"]["xi+xi_k (ceres)"]["envelope"]
         ls = self.s["ladder"]["xi+xi_k"]["envelope"]
-        for e, q, lo, hi in ((ce, 4874, 4338, 5560), (ls, 4481, 4295, 4683)):
+        for e, q, lo, hi in ((ce, 4874, 4281, 5656), (ls, 4481, 4295, 4683)):
             self.assertAlmostEqual(e["Q"], q, delta=20)
             self.assertAlmostEqual(e["Q_ci_low"], lo, delta=20)
             self.assertAlmostEqual(e["Q_ci_high"], hi, delta=20)

@@ -223,6 +223,14 @@ class FreeDecayFitter : public NestedModelFitter {
   }
 
   std::vector<BlockResidual> blocks(const NestedFit& fit) const override {
+    // A cheap fit nested in an earlier one keeps no residual vector (fitCheap): recomputed here,
+    // one pass over the record, when the selection asks for its blocks.
+    if (fit.residuals.size() == 0 && fit.estimate.values.size() > 0) {
+      NestedFit with = fit;
+      with.residuals = equationResidualsStreamed(
+          ResonatorModel(fit.model, ExperimentMode::kFreeDecay), fit.estimate.values);
+      return blocks(with);
+    }
     // Block i of (2.8) is centred on sample i + 1 (one record).
     const size_t nb = fit.residuals.size() / 4;
     std::vector<Eigen::Vector4d> q(nb);

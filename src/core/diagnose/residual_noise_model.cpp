@@ -1,8 +1,12 @@
 #include "cvg_bench/core/diagnose/residual_noise_model.h"
 
+#include <Eigen/Dense>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+
+#include "cvg_bench/core/estimate/fitted_residual_ar1.h"
 
 namespace cvg_bench {
 namespace {
@@ -72,6 +76,61 @@ ResidualNoiseModel noiseModelFromResiduals(const Eigen::VectorXd& residuals, int
   m.ar = {rho};
   m.rho1 = rho;
   m.description = "AR(1) fitted to the residuals (variogram ratio, rho = " + num(rho) + ")";
+  return m;
+}
+
+ResidualNoiseModel noiseModelFromDetrendedResiduals(const Eigen::VectorXd& residuals, int channels,
+                                                    int degree, double ceiling, double min_rho) {
+  ResidualNoiseModel m;
+  channels = std::max(1, channels);
+  const long n = residuals.size() / channels;
+  degree = std::max(0, degree);
+  double c0 = 0.0, c1 = 0.0;
+  if (n > 4 * (degree + 1)) {
+    // Legendre P_0..P_degree of the scaled sample index (Bonnet's recurrence).
+    Eigen::MatrixXd b(n, degree + 1);
+    for (long i = 0; i < n; ++i) {
+      const double s = n > 1 ? 2.0 * i / (n - 1.0) - 1.0 : 0.0;
+      b(i, 0) = 1.0;
+      if (degree >= 1) b(i, 1) = s;
+      for (int k = 1; k < degree; ++k)
+        b(i, k + 1) = ((2.0 * k + 1.0) * s * b(i, k) - k * b(i, k - 1)) / (k + 1.0);
+    }
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(b);
+    for (int c = 0; c < channels; ++c) {
+      Eigen::VectorXd x(n);
+      for (long i = 0; i < n; ++i) x[i] = residuals[i * channels + c];
+      x -= b * qr.solve(x);
+      c0 += x.squaredNorm();
+      c1 += x.head(n - 1).dot(x.tail(n - 1));
+    }
+  }
+  double rho = c0 > 0.0 ? std::max(-0.5, c1 / c0) : 0.0;
+  if (c0 > 0.0) {
+    // The smooth part takes slow noise with it: lag-1 correlation corrected for the projection.
+    Eigen::MatrixXd b(n, degree + 1);
+    for (long i = 0; i < n; ++i) {
+      const double s = n > 1 ? 2.0 * i / (n - 1.0) - 1.0 : 0.0;
+      b(i, 0) = 1.0;
+      if (degree >= 1) b(i, 1) = s;
+      for (int k = 1; k < degree; ++k)
+        b(i, k + 1) = ((2.0 * k + 1.0) * s * b(i, k) - k * b(i, k - 1)) / (k + 1.0);
+    }
+    const Eigen::MatrixXd gram_inv =
+        (b.transpose() * b).completeOrthogonalDecomposition().pseudoInverse();
+    rho = std::max(-0.5, fittedResidualAr1(b, gram_inv, 1, rho));
+  }
+  const bool capped = rho > ceiling;
+  rho = std::min(rho, ceiling);
+  if (std::abs(rho) < min_rho) {
+    m.description = "white (AR(1) of the detrended residuals rho = " + num(rho) + ")";
+    return m;
+  }
+  m.ar = {rho};
+  m.rho1 = rho;
+  m.description = "AR(1) fitted to the residuals after Legendre P_0..P_" + std::to_string(degree) +
+                  " in time are removed (rho = " + num(rho) +
+                  (capped ? ", capped: the fitted value exceeds the ceiling" : "") + ")";
   return m;
 }
 

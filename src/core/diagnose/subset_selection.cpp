@@ -8,6 +8,8 @@
 //   3. the best refined subset is checked backwards (a term goes when the subset without it
 //      scores better) and confirmed on the hold-out: it must predict the held-out data better than
 //      the linear model, else the next subset in criterion order is tried;
+//      (before 3, every one-term extension of the best refined subset is refined as well, until
+//      none scores better: the LS ranking can miss terms that act together);
 //   4. the steps ladder adds the chosen terms one at a time, best refined criterion first; the
 //      runner-up is the best refined subset not chosen.
 // Subsets act together: cubic + quintic stiffness in a decay are nearly collinear (amplitude^2 and
@@ -279,6 +281,25 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
                      [](const auto& a, const auto& b) { return a.first < b.first; });
     return r;
   };
+  // Refined neighbours: the LS ranking of (2.8) can miss a subset whose terms act together (its
+  // errors-in-variables bias hides small terms), so every one-term extension of the best refined
+  // subset is refined too, until none scores better.
+  for (int round = 0; round < options.max_steps; ++round) {
+    const auto r = ranked();
+    if (r.empty()) break;
+    const Terms best = r.front().second;
+    const double best_v = r.front().first;
+    bool improved = false;
+    for (const auto& name : search.names()) {
+      if (std::find(best.begin(), best.end(), name) != best.end()) continue;
+      Terms t = best;
+      t.push_back(name);
+      t = search.canonical(t);
+      if (static_cast<int>(t.size()) > options.max_steps || crit.count(key(t))) continue;
+      if (score(t) < best_v) improved = true;
+    }
+    if (!improved) break;
+  }
   const double base_crit = score({});
   std::vector<std::string> rejected_keys;
   Terms chosen;

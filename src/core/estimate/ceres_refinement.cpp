@@ -11,6 +11,7 @@
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/collinearity.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/estimate/fitted_residual_ar1.h"
 #include "cvg_bench/core/estimate/hac_covariance.h"
 #include "cvg_bench/core/estimate/identifiability.h"
 #include "cvg_bench/core/estimate/least_squares_solver.h"
@@ -332,11 +333,14 @@ CeresCovariance outputErrorCovariance(const FittedProblem& fp, const AtSolution&
       // A noise model: AR(1) on each slow variable with rho = the residuals' lag-1 correlation
       // (rho_l = rho^l kept while > 1e-3). Under AR(1) rho = 0.9 this holds 95 % coverage where
       // the HAC sandwich on ~10^3 samples gives ~0.90 (correlated_intervals_test).
+      // The fit removes mostly slow noise, so the residuals' lag-1 correlation understates rho:
+      // corrected by its expectation under the fit (fitted_residual_ar1.h).
       rho.clear();
-      const double r1 = std::min(test.lag1, 0.995);
+      const double r1 = std::min(fittedResidualAr1(a.j, unscaled, 4, test.lag1), 0.995);
       for (double v = r1; v > 1e-3 && static_cast<long>(rho.size()) < n / 8; v *= r1)
         rho.push_back(v);
-      source = "AR(1) fitted to the residuals' lag-1 correlation";
+      source = "AR(1) fitted to the residuals' lag-1 correlation " + fmt3(test.lag1) +
+               " (corrected for the fit)";
       id = "ar1_fitted";
     } else if (n / 4 > 3 * a.j.cols()) {
       const HacCovariance hac = hacCovarianceBlocked(a.j, a.residuals, 4);
@@ -402,20 +406,13 @@ void fillIdentifiability(const FittedProblem& fp, const AtSolution& a, const Ran
                      "): intervals of the unidentifiable parameters are not meaningful");
 }
 
-/// Rank, covariance, intervals, identifiability and derived quantities of the fitted problem.
-void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estimate* e) {
-  const AtSolution a = evaluateAtSolution(fp);
+/// The reported parameters' values, covariance and Student-t intervals (dof = n - rank).
+void fillIntervals(const FittedProblem& fp, const AtSolution& a, const RankAnalysis& r,
+                   const CeresCovariance& cc, const CeresOptions& options, double s_p,
+                   Estimate* e) {
   const int n = static_cast<int>(a.j.rows()), p = static_cast<int>(a.j.cols());
-  const RankAnalysis r = numericalRank(a.j, options.rank_tolerance);
-  const int dof = n - r.rank;
-  if (dof < 1)
-    throw AnalysisError("Ceres refinement: no degrees of freedom left (" + std::to_string(n) +
-                        " residuals, rank " + std::to_string(r.rank) + ")");
-  const Eigen::MatrixXd unscaled = unscaledCovariance(fp, a, r, options, e);
-  const CeresCovariance cc = outputErrorCovariance(fp, a, unscaled, dof, e);
-
   const int k = fp.n_reported;
-  const double s_p = studentQuantile(options.confidence, dof);
+  const int dof = n - r.rank;
   e->method = "ceres";
   e->n_equations = n;
   e->n_params = k;
@@ -435,6 +432,22 @@ void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estima
   e->parameters_paper.clear();
   e->singular_values.assign(r.s.data(), r.s.data() + r.s.size());
   e->rank_tolerance = options.rank_tolerance;
+}
+
+/// Rank, covariance (outputErrorCovariance), intervals (fillIntervals), identifiability and
+/// derived quantities of the fitted problem.
+void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estimate* e) {
+  const AtSolution a = evaluateAtSolution(fp);
+  const int n = static_cast<int>(a.j.rows());
+  const RankAnalysis r = numericalRank(a.j, options.rank_tolerance);
+  const int dof = n - r.rank;
+  if (dof < 1)
+    throw AnalysisError("Ceres refinement: no degrees of freedom left (" + std::to_string(n) +
+                        " residuals, rank " + std::to_string(r.rank) + ")");
+  const Eigen::MatrixXd unscaled = unscaledCovariance(fp, a, r, options, e);
+  const CeresCovariance cc = outputErrorCovariance(fp, a, unscaled, dof, e);
+  const double s_p = studentQuantile(options.confidence, dof);
+  fillIntervals(fp, a, r, cc, options, s_p, e);
   fillIdentifiability(fp, a, r, cc.cov, s_p, e);
   e->derived.clear();
   e->derived_method.clear();

@@ -5,7 +5,9 @@
 // Steps: (1) fit the linear baseline and read its residual signature (residual_signature.h);
 // (2) best-subset selection over the candidate extensions (forward_selection.h) with the gain of
 // every step and the runner-up; (3) lack-of-fit test of the final model, its residuals whitened
-// by the noise model of residual_noise_model.h (known demodulator correlation or AR(1)):
+// by the noise model of residual_noise_model.h (known demodulator correlation, else AR(1) fitted
+// after the smooth part is removed); in free decay also the low-frequency GLS test of
+// low_frequency_misfit.h, Bonferroni with the runs test:
 //   forced sweep: Wald-Wolfowitz runs test of the per-point residuals ordered by drive frequency
 //     (points do not share samples, so they are independent under an adequate model), on the
 //     radial and tangential projections and the 4 components, Bonferroni over the 6 sequences;
@@ -15,8 +17,7 @@
 //     residuals are the measurement noise itself under an adequate model. Decimated to ~200
 //     values per sequence;
 // (4) the verdict in words: cause, parameter with CI, gain; `unexplained` when the final model
-// still fails the lack-of-fit test or keeps a significant residual signature (of the whitened
-// equation residuals).
+// still fails the lack-of-fit test (forced sweeps: or keeps a significant residual signature).
 // The ROS identifier node's Explain service and the tool's `explain` subcommand both call
 // explainFreeDecay / explainForced.
 #pragma once
@@ -55,7 +56,12 @@ struct LackOfFit {
   double p_value = 1.0;     ///< Bonferroni-combined p-value (residuals whitened by the noise model)
   std::string worst;        ///< the sequence with the fewest runs relative to expectation
   std::string noise_model;  ///< the whitening noise model, in words
-  double p_value_unwhitened = 1.0;  ///< the same test on the raw residuals (for comparison)
+  double p_value_unwhitened = 1.0;     ///< the same test on the raw residuals (for comparison)
+  double runs_p_value = 1.0;           ///< the whitened runs test alone
+  double low_frequency_p_value = 1.0;  ///< free decay: low_frequency_misfit.h (1 in forced mode)
+  std::string low_frequency;           ///< that test's worst sequence, in words
+  double signature_p_value =
+      1.0;  ///< smallest final-signature p-value times the entries (Bonferroni)
 };
 
 struct Explanation {

@@ -8,10 +8,13 @@
 // before the runs test and the signature:
 //   known correlation rho_1..rho_L (a demodulated record's noise_correlation): AR(p) by
 //     Levinson-Durbin on rho (p = min(L, 30));
-//   otherwise AR(1) with rho from the variogram ratio
+//   otherwise AR(1) of the residuals after a smooth part (Legendre polynomials in time) is removed,
+//   its lag-1 correlation corrected for that projection and capped at 0.95
+//   (noiseModelFromDetrendedResiduals, used by explain). The older variogram-ratio estimate
 //     rho = (1 - r_2) / (1 - r_1) - 1,   r_l the lag-l residual autocorrelation,
-//   which a slowly varying misfit s (s_t ~ s_{t-1} ~ s_{t-2}) leaves unchanged, unlike r_1 itself:
-//   a missing effect is not mistaken for correlated noise and whitened away.
+//   (noiseModelFromResiduals) is fooled by a curved misfit larger than the noise: its increments
+//   grow as l^2, the ratio tends to 4 and rho to its clamp, whitening the misfit away (the
+//   Foucault record, docs/examples/foucault.md).
 // A smooth misfit passes the filter scaled by (1 - sum a_k), so it stays visible to the tests.
 #pragma once
 
@@ -34,6 +37,15 @@ ResidualNoiseModel noiseModelFromCorrelation(const std::vector<double>& rho, int
 /// channel r % channels), rho clamped to [-0.5, 0.98]; white when |rho| < min_rho.
 ResidualNoiseModel noiseModelFromResiduals(const Eigen::VectorXd& residuals, int channels,
                                            double min_rho = 0.05);
+
+/// AR(1) of each channel's residuals after a least-squares fit of Legendre polynomials of degree
+/// <= `degree` in the sample index is removed (a smooth misfit has lag-1 correlation ~1 and would
+/// otherwise pass for correlated noise), Yule-Walker rho averaged over the channels, capped at
+/// `ceiling` (a correlation time beyond ~1 / (1 - ceiling) samples is not told from a misfit on one
+/// record); white when |rho| < min_rho.
+ResidualNoiseModel noiseModelFromDetrendedResiduals(const Eigen::VectorXd& residuals, int channels,
+                                                    int degree = 5, double ceiling = 0.95,
+                                                    double min_rho = 0.05);
 
 /// Applies the whitening filter to each channel (the first p samples of a channel use the
 /// available past only).
