@@ -9,6 +9,9 @@ root=$(pwd)
 b="$root/build/fuzz"
 jobs=${JOBS:-2}
 secs=${FUZZ_SECONDS:-60}
+# FUZZ_SEED: a fixed libFuzzer seed (CI sets one, so that its run is a reproducible prefix of the
+# same input sequence on every machine); unset or 0 = a new random seed each run.
+seed=${FUZZ_SEED:-0}
 msg_include="$root/build/ws/devel/include"
 extra=()
 if [ -f "$msg_include/cvg_bench/SlowState.h" ]; then
@@ -39,7 +42,7 @@ for t in "${targets[@]}"; do
   regress=()
   [ -d "$root/test/fuzz/regressions/$c" ] && regress=("$root/test/fuzz/regressions/$c")
   echo "fuzz: $t for $secs s"
-  if ! (cd "$b/crashes/$c" && "$b/$t" -max_total_time="$secs" -max_len=65536 -timeout=10 \
+  if ! (cd "$b/crashes/$c" && "$b/$t" -max_total_time="$secs" -seed="$seed" -max_len=65536 -timeout=10 \
         -rss_limit_mb=2048 -print_final_stats=1 "$b/corpus/$c" "$root/test/fuzz/corpus/$c" "${regress[@]}" \
         > "$b/$t.log" 2>&1); then
     failed=1

@@ -430,6 +430,12 @@ class BadInputSuite(unittest.TestCase):
                    ("fuzz: connection header field length beyond its record (regression)",
                     os.path.join(ROOT, "test", "fuzz", "regressions", "bag",
                                  "connection_header_field_length.bag")),
+                   ("fuzz: index offset outside its chunk (regression)",
+                    os.path.join(ROOT, "test", "fuzz", "regressions", "bag",
+                                 "index_offset_outside_chunk.bag")),
+                   ("fuzz: index offset outside its chunk, second find (regression)",
+                    os.path.join(ROOT, "test", "fuzz", "regressions", "bag",
+                                 "index_offset_outside_chunk_2.bag")),
                    ("version line with a 200-character word", self.write(
                        b"#ROS" + b"A" * 200 + b" V2.0\n" + data[13:], ".bag", binary=True)),
                    ("first record length 1.9e9", self.write(data[:13] + big + data[17:], ".bag",
@@ -442,6 +448,21 @@ class BadInputSuite(unittest.TestCase):
                        "bad", names=(path,))
             self.assertTrue("no rosbag support" in err or "byte" in err or "format 2.0" in err,
                             label + ": " + err)
+        # A compressed bag (rosbag record --lz4): refused with the way out, not read unchecked.
+        try:
+            import rosbag
+        except ImportError:
+            rosbag = None
+        if rosbag is not None:
+            lz4 = self.write(b"", ".bag", binary=True)
+            with rosbag.Bag(BAG) as src, rosbag.Bag(lz4, "w", compression="lz4") as dst:
+                for topic, msg, t in src.read_messages(raw=True):
+                    dst.write(topic, msg, t, raw=True)
+            rc, _, err = run_tool(["identify", lz4, "--mode", "free_decay", "--model", "linear"])
+            if "no rosbag support" not in err:
+                self.check("lz4-compressed bag", ["identify", lz4, "--mode", "free_decay",
+                                                  "--model", "linear"], "bad",
+                           names=(lz4, "compressed", "rosbag decompress"))
         self.check("bag with --mode forced", ["identify", BAG, "--mode", "forced", "--model",
                                               "linear"], "bad", names=(BAG,))
         rc, _, err = run_tool(["identify", BAG, "--mode", "free_decay", "--model", "linear"])
@@ -460,6 +481,20 @@ class BadInputSuite(unittest.TestCase):
         js = self.out()
         self.check("valid bag", ["identify", BAG, "--mode", "free_decay", "--model", "linear",
                                  "--json", js], "ok")
+
+    def test_fuzz_findings(self):
+        """Inputs the fuzzers crashed the readers with (test/fuzz/regressions/): now exit 2."""
+        reg = os.path.join(ROOT, "test", "fuzz", "regressions")
+        # A sweep's jump flag 7.8e27: integral, but no int (UB in the conversion).
+        csv = os.path.join(reg, "csv", "flag_column_7e27.csv")
+        self.check("fuzz: direction flag 7.8e27 (regression)",
+                   ["identify", csv, "--mode", "forced", "--model", "linear"], "bad",
+                   names=(csv + ":3:7", "jump"))
+        # A YAML map used as a key (`? nu: ...`): yaml-cpp threw through the key conversion.
+        yml = os.path.join(reg, "preset", "map_as_key.yaml")
+        self.check("fuzz: preset with a map as a key (regression)",
+                   ["simulate", "--config", yml, "--mode", "free_decay", "--out",
+                    self.out(".csv")], "bad", names=(yml, "not text"))
 
     # ---- options --------------------------------------------------------------------------------
     def test_absurd_options(self):

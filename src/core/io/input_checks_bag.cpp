@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -12,13 +13,16 @@ namespace cvg_bench {
 namespace {
 
 constexpr char kMagic[] = "#ROSBAG V2.0\n";
-constexpr uint8_t kOpBagHeader = 0x03, kOpChunk = 0x05, kOpChunkInfo = 0x06, kOpConnection = 0x07;
+constexpr uint8_t kOpMessageData = 0x02, kOpBagHeader = 0x03, kOpIndexData = 0x04, kOpChunk = 0x05,
+                  kOpChunkInfo = 0x06, kOpConnection = 0x07;
 
 struct Walker {
   std::ifstream in;
   std::string path;
   std::set<uint64_t> starts;         ///< offsets of the file's top-level records
   std::vector<uint64_t> must_start;  ///< offsets the index points at
+  bool seen_chunk = false;           ///< an index data record follows the chunk it indexes
+  std::map<uint64_t, int> chunk_ops;  ///< last chunk: record offset in its data -> op
 
   [[noreturn]] void fail(uint64_t at, const std::string& what) {
     std::ostringstream m;
@@ -65,6 +69,26 @@ struct Walker {
     return out;
   }
 
+  /// An index data record (version 1: count x {time 8 bytes, offset 4 bytes}): each offset must
+  /// start a message data record of the chunk before it (rosbag reads there without a bounds
+  /// check: fuzzing found a SEGV in readHeaderFromBuffer).
+  void checkIndexData(uint64_t pos, uint64_t data_at, uint64_t data_len, uint64_t ver,
+                      uint64_t count) {
+    if (!seen_chunk) fail(pos, "index data before any chunk");
+    if (ver != 1) fail(pos, "index data version " + std::to_string(ver) + " (only 1 is known)");
+    if (data_len != count * 12)
+      fail(pos, "index data of " + std::to_string(count) + " entries in " +
+                    std::to_string(data_len) + " bytes");
+    const std::string d = read(data_at, data_len);
+    for (uint64_t i = 0; i < count; ++i) {
+      const uint64_t off = le(d.substr(i * 12 + 8, 4));
+      const auto it = chunk_ops.find(off);
+      if (it == chunk_ops.end() || it->second != kOpMessageData)
+        fail(data_at + i * 12, "the index points at chunk offset " + std::to_string(off) +
+                                   ", which starts no message record");
+    }
+  }
+
   /// Walks the records in [begin, end); top = the file's top level (not inside a chunk).
   void walk(uint64_t begin, uint64_t end, bool top) {
     uint64_t pos = begin;
@@ -83,8 +107,8 @@ struct Walker {
         fail(pos, "record data length " + std::to_string(data_len) + " bytes beyond the end");
       int op = -1;
       std::string compression;
-      uint64_t chunk_size = 0, index_pos = 0, chunk_pos = 0;
-      bool has_size = false, has_index_pos = false, has_chunk_pos = false;
+      uint64_t chunk_size = 0, index_pos = 0, chunk_pos = 0, ver = 0, count = 0;
+      bool has_size = false, has_index_pos = false, has_chunk_pos = false, has_count = false;
       for (const auto& nv : fields(pos + 4, header)) {
         const std::string &name = nv.first, &value = nv.second;
         if (name == "op" && value.size() == 1) op = static_cast<uint8_t>(value[0]);
@@ -92,6 +116,14 @@ struct Walker {
         if (name == "size" && value.size() == 4) chunk_size = le(value), has_size = true;
         if (name == "index_pos" && value.size() == 8) index_pos = le(value), has_index_pos = true;
         if (name == "chunk_pos" && value.size() == 8) chunk_pos = le(value), has_chunk_pos = true;
+        if (name == "ver" && value.size() == 4) ver = le(value);
+        if (name == "count" && value.size() == 4) count = le(value), has_count = true;
+      }
+      if (!top) chunk_ops[pos - begin] = op;
+      if (op == kOpIndexData) {
+        if (!top) fail(pos, "index data inside a chunk");
+        if (!has_count) fail(pos, "index data without its count");
+        checkIndexData(pos, data_at, data_len, ver, count);
       }
       if (op == kOpConnection) fields(data_at, read(data_at, data_len));
       if (op == kOpBagHeader && top && has_index_pos && index_pos != 0)
@@ -100,14 +132,17 @@ struct Walker {
       if (op == kOpChunk) {
         if (!top) fail(pos, "chunk inside a chunk");
         if (!has_size) fail(pos, "chunk without its size");
-        if (compression == "none") {
-          if (chunk_size != data_len)
-            fail(pos, "uncompressed chunk size differs from its data length");
-          walk(data_at, data_at + data_len, false);
-        } else if (chunk_size > kMaxBagChunkBytes) {
-          fail(pos, "chunk of " + std::to_string(chunk_size) + " bytes uncompressed (limit " +
+        if (compression != "none")  // its records cannot be checked without decompressing
+          fail(pos, "chunk compressed with '" + compression +
+                        "' (not read: decompress the bag first, `rosbag decompress`)");
+        if (chunk_size != data_len)
+          fail(pos, "uncompressed chunk size differs from its data length");
+        if (chunk_size > kMaxBagChunkBytes)
+          fail(pos, "chunk of " + std::to_string(chunk_size) + " bytes (limit " +
                         std::to_string(kMaxBagChunkBytes) + ")");
-        }
+        chunk_ops.clear();
+        seen_chunk = true;
+        walk(data_at, data_at + data_len, false);
       }
       pos = data_at + data_len;
     }

@@ -238,7 +238,8 @@ std::vector<int> flagColumn(const Table& table, const std::string& name,
   std::vector<int> out;
   for (size_t r = 0; r < table.row_line.size(); ++r) {
     const double v = table.columns[c][r];
-    if (v != std::round(v) || !allowed.count(static_cast<int>(v)))
+    // Range check first: a flag like 7.8e27 is integral but no int (UB to convert).
+    if (v != std::round(v) || std::abs(v) > 1e6 || !allowed.count(static_cast<int>(v)))
       throw InputError(table.where(table.row_line[r], c + 1) + "column '" + name +
                        "': " + formatDouble(v) + " is not one of the allowed flags");
     out.push_back(static_cast<int>(v));

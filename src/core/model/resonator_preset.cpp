@@ -52,6 +52,10 @@ class SectionReader {
       return;
     }
     for (const auto& kv : map) {
+      if (!kv.first.IsScalar()) {  // a map or list used as a key (`? [a, b]: 1`)
+        problems_.push_back(path_ + ":" + at(kv.first) + "a key in " + section + " is not text");
+        continue;
+      }
       const std::string key = kv.first.as<std::string>();
       const auto it = setters.find(key);
       if (it == setters.end()) {
@@ -300,7 +304,12 @@ ResonatorPreset loadResonatorPresetFile(const std::string& path) {
       {"integrator", [&](const YAML::Node& n) { r.read(n, "integrator", integrator); }},
       {"free_decay", [&](const YAML::Node& n) { r.read(n, "free_decay", free_decay); }},
       {"forced", [&](const YAML::Node& n) { r.read(n, "forced", forced); }}};
-  r.read(root, "the preset", top);
+  try {
+    r.read(root, "the preset", top);
+  } catch (const YAML::Exception& e) {  // any conversion the setters did not anticipate
+    problems.push_back(path + ":" + std::to_string(e.mark.line + 1) + ":" +
+                       std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
   for (const auto& v : p.validate()) problems.push_back(path + ": " + v);
   if (!problems.empty()) throw InputError(joinProblems("invalid preset " + path + ":", problems));
   return p;

@@ -2,9 +2,11 @@
 // offsets stored in the file: a corrupted record length (fuzzing found 2.3e9 bytes in a 17 kB
 // bag) makes it allocate that much before it notices the file is shorter. Every record of the file
 // is walked here (4-byte header length, header fields, 4-byte data length, data; the records
-// inside uncompressed chunks too) and each length must fit in what remains of the file or chunk;
-// the offsets of the index (bag header `index_pos`, chunk info `chunk_pos`) must be the start of a
-// record; an uncompressed chunk size may not exceed kMaxBagChunkBytes. Only reads headers.
+// inside chunks too) and each length must fit in what remains of the file or chunk; the offsets of
+// the index (bag header `index_pos`, chunk info `chunk_pos`) must be the start of a record, and
+// each index data entry must point at a message record of the chunk before it; a chunk may not
+// exceed kMaxBagChunkBytes. Compressed chunks (bz2, lz4) are refused: their records cannot be
+// checked without decompressing (`rosbag decompress` first). Reads headers and index entries.
 #pragma once
 
 #include <cstdint>
