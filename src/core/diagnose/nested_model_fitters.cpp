@@ -1,17 +1,20 @@
 #include "cvg_bench/core/diagnose/nested_model_fitters.h"
 
 #include <Eigen/QR>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "cvg_bench/core/demod/demodulator_noise.h"
+#include "cvg_bench/core/diagnose/sweep_noise_model.h"
 #include "cvg_bench/core/estimate/free_decay_regression.h"
 #include "cvg_bench/core/estimate/identify_pipeline.h"
 #include "cvg_bench/core/estimate/least_squares_solver.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_model.h"
+#include "cvg_bench/core/model/stationary_solver.h"
 
 namespace cvg_bench {
 
@@ -378,11 +381,56 @@ class ForcedFitter : public NestedModelFitter {
     return blockResiduals(fit.residuals, record_.q, record_.omega0_rad_s, lambda);
   }
 
+  /// Output-error residuals to first order, r_j = A_j^{-1} F(q_j) (sweep_noise_model.h): the
+  /// equation residual's scale grows with the detuning; r is in amplitude units at every point.
+  /// Points at a fold of the response (A_j singular) are left out.
   std::vector<BlockResidual> adequacyResiduals(const NestedFit& fit) const override {
-    return blocks(fit);
+    return linearize(fit).blocks;
   }
 
  private:
+  /// A_j = dF/dq (stationary_solver.h) and the linearized output error at the measured points.
+  struct Linearized {
+    std::vector<size_t> index;          ///< sweep point of each entry (folds left out)
+    std::vector<Eigen::Matrix4d> a;     ///< A_j
+    std::vector<BlockResidual> blocks;  ///< r_j = A_j^{-1} F(q_j) as residual blocks
+  };
+
+  double knownOrFittedMu(const NestedFit& fit) const {
+    return ResonatorModel(fit.extensions, ExperimentMode::kForced).estimatesMu()
+               ? fit.estimate.parameters.at(ResonatorModel::muName()).value
+               : options_.identification.mu;
+  }
+
+  Linearized linearize(const NestedFit& fit) const {
+    const ResonatorModel model =
+        ResonatorModel(fit.extensions, ExperimentMode::kForced).linearPart();
+    const Eigen::VectorXd z = linearPart(fit);
+    const SlowContext ctx{0.0, knownOrFittedMu(fit)};
+    Linearized out;
+    Eigen::VectorXd r(4 * record_.size());
+    std::vector<Eigen::Vector4d> q;
+    std::vector<double> abscissa, lambda;
+    long k = 0;
+    for (size_t j = 0; j < record_.size(); ++j) {
+      const double rate = detuningRate(omega_, record_.omega0_rad_s[j]);
+      const Eigen::Matrix4d a = stationaryJacobian(model, record_.q[j], ctx, z, rate);
+      const Eigen::JacobiSVD<Eigen::Matrix4d> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      const auto& sv = svd.singularValues();
+      if (!(sv(3) > 1e-9 * sv(0))) continue;  // a fold: no linearization
+      const Eigen::Vector4d dq = svd.solve(stationaryResidual(model, record_.q[j], ctx, z, rate));
+      if (!dq.allFinite()) continue;
+      r.segment<4>(4 * k++) = dq;
+      out.index.push_back(j);
+      out.a.push_back(a);
+      q.push_back(record_.q[j]);
+      abscissa.push_back(record_.omega0_rad_s[j]);
+      lambda.push_back(record_.omega0_rad_s[j] - omega_);
+    }
+    out.blocks = blockResiduals(r.head(4 * k), q, abscissa, lambda);
+    return out;
+  }
+
   /// The linear (in z) part's options: the base spec and the fitted mu when mu is estimated.
   IdentificationOptions optionsFor(const std::vector<std::string>& ext, const NestedFit& f) const {
     IdentificationOptions o = options_.identification;

@@ -19,9 +19,9 @@ constexpr uint8_t kOpMessageData = 0x02, kOpBagHeader = 0x03, kOpIndexData = 0x0
 struct Walker {
   std::ifstream in;
   std::string path;
-  std::set<uint64_t> starts;         ///< offsets of the file's top-level records
-  std::vector<uint64_t> must_start;  ///< offsets the index points at
-  bool seen_chunk = false;           ///< an index data record follows the chunk it indexes
+  std::set<uint64_t> starts;          ///< offsets of the file's top-level records
+  std::vector<uint64_t> must_start;   ///< offsets the index points at
+  bool seen_chunk = false;            ///< an index data record follows the chunk it indexes
   std::map<uint64_t, int> chunk_ops;  ///< last chunk: record offset in its data -> op
 
   [[noreturn]] void fail(uint64_t at, const std::string& what) {
