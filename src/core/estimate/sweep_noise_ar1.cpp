@@ -64,8 +64,8 @@ SweepAr1 sweepNoiseAr1(const std::vector<Eigen::Vector4d>& r, const std::vector<
     return out;
   }
   out.rho = rho;
-  d << "AR(1) along the sweep, rho " << rho << (out.capped ? " (capped)" : "") << ", from the "
-    << n << " quiet points (amplitude^2 <= " << options.quiet_fraction
+  d << "AR(1) along the sweep, rho " << rho << (out.capped ? " (capped)" : "") << ", from the " << n
+    << " quiet points (amplitude^2 <= " << options.quiet_fraction
     << " x the largest) of the output-error residuals after Legendre P_0..P_" << k - 1
     << " in the drive frequency";
   out.description = d.str();
