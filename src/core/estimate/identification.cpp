@@ -22,8 +22,8 @@
 #include "cvg_bench/core/estimate/residual_correlation.h"
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/estimate/sweep_noise_ar1.h"
-#include "cvg_bench/core/model/stationary_solver.h"
 #include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/stationary_solver.h"
 
 namespace cvg_bench {
 namespace {
