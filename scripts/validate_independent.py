@@ -361,7 +361,9 @@ def summarize_coverage(results):
         if r["status"] != "ok":
             d["failed"] += 1
             continue
-        d["methods"].add(r.get("interval_method") or "")
+        # Numbers (fitted rho, lags) vary per run: one entry per method, numbers shown as '#'.
+        d["methods"].add(re.sub(r"(?<![\w^(_.])-?(\d+\.\d+(e[-+]?\d+)?|\d{2,})", "#",
+                                r.get("interval_method") or ""))
         for k, v in r["params"].items():
             d["rows"].setdefault(k, []).append(v)
     for d in out.values():
@@ -586,7 +588,8 @@ def load_runs(args):
         kinds += [k for k in d["kinds"] if k not in kinds]
         terms = d.get("library_terms_beyond_ten", []) if terms is None else terms
         args.tool_commit = d.get("tool", "?")
-        args.parts = getattr(args, "parts", []) + [",".join(d["kinds"])]
+        args.parts = getattr(args, "parts", []) + ["%s (tool %s)" % (",".join(d["kinds"]),
+                                                                      d.get("tool", "?"))]
         gen += d.get("gen_cpu_s", 0.0)
     args.terms, args.gen_cpu = terms or [], gen
     args.kinds = ",".join(k for k in KINDS if k in kinds)
@@ -804,7 +807,7 @@ def report_header(args, elapsed, n):
                 args.jobs, getattr(args, "tool_commit", None) or tool_version(args.tool),
                 ", ".join(args.terms) or "none"),
             ] + ([("Assembled by --from-json from separate runs of the same command with "
-                   "--kinds %s (each --jobs 1)." % "; --kinds ".join(args.parts))]
+                   "--kinds %s." % "; --kinds ".join(args.parts))]
                  if getattr(args, "parts", None) else []) + [
             "", "Cost: the tool's CPU time (user + system, summed over runs) %.0f s, i.e. %.1f min "
             "on %d unloaded cores; generator %.0f s (CPU, cached trajectories not counted). "
