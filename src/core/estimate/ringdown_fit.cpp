@@ -336,6 +336,33 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
     const double lvl = acc / c;
     d.w(i) = 1.0 / (s_m2 + s_a2 * std::exp(-2.0 * lvl));
   }
+  // Weights at the observed level correlate with the noise of the same samples (a sample lifted
+  // by noise reads as quieter and weighs more), which pulls the tail up and the rate down under
+  // additive noise (Q 1-5 % high). The level for the weights is therefore a smooth of the whole
+  // span instead: a weighted Legendre polynomial of degree 6 in time (leverage 7 / n per sample),
+  // refitted once with its own weights. The same for every model, so criteria compare.
+  if (additive && n > 40) {
+    for (int pass = 0; pass < 2; ++pass) {
+      const int deg = 6;
+      Eigen::MatrixXd X(n, deg + 1);
+      Eigen::VectorXd Y(n);
+      for (int i = 0; i < n; ++i) {
+        const double sw = std::sqrt(d.w(i)), x = 2.0 * d.t(i) - 1.0;
+        double p0 = 1.0, p1 = x;
+        X(i, 0) = sw, X(i, 1) = sw * x;
+        for (int k = 2; k <= deg; ++k) {
+          const double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
+          X(i, k) = sw * p2, p0 = p1, p1 = p2;
+        }
+        Y(i) = sw * d.y(i);
+      }
+      const Eigen::VectorXd c = X.colPivHouseholderQr().solve(Y);
+      for (int i = 0; i < n; ++i) {
+        const double lvl = X.row(i).dot(c) / std::sqrt(d.w(i));
+        d.w(i) = 1.0 / (s_m2 + s_a2 * std::exp(-2.0 * lvl));
+      }
+    }
+  }
   // Normalize the weights to mean 1 (sigma then reads in units of the mean sd).
   d.w /= d.w.mean();
 
@@ -419,8 +446,8 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
   fit.long_run_factor = rc.long_run_factor;
   fit.effective_n = rc.effective_n;
   fit.interval_method = rc.method + "; " + fit.error_model + " error model";
-  const double z = studentQuantile(
-      options.confidence, std::max(1, static_cast<int>(std::floor(fit.effective_n)) - p_n));
+  const double z =
+      studentQuantile(options.confidence, std::max(1, static_cast<int>(rc.student_df)));
 
   // Physical values. Time scale T: rates in 1/T -> 1/s divide by T.
   const double T = fit.t_scale_s;
@@ -520,8 +547,8 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
       const Eigen::VectorXd res = Y - X * c;
       const RingdownCovariance hb = ringdownCovariance(X, res);
       RingdownValue rate;
-      const double zb = studentQuantile(
-          options.confidence, std::max(1, static_cast<int>(std::floor(hb.effective_n)) - 2));
+      const double zb =
+          studentQuantile(options.confidence, std::max(1, static_cast<int>(hb.student_df)));
       rate.value = c(1) / ts;  // in 1/T
       rate.std = std::sqrt(std::max(0.0, hb.covariance(1, 1))) / ts;
       rate.ci_low = rate.value - zb * rate.std, rate.ci_high = rate.value + zb * rate.std;

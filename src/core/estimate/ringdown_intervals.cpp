@@ -10,6 +10,9 @@ namespace {
 
 constexpr int kMaxArOrder = 12;
 constexpr int kLjungBoxLags = 10;
+constexpr int kBlocks = 16;
+
+RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r);
 
 /// Autocorrelations r_1..r_L of x (mean removed).
 std::vector<double> autocorrelation(const Eigen::VectorXd& x, int lags) {
@@ -68,9 +71,61 @@ std::vector<double> arAutocorrelation(const std::vector<double>& a, int max_lag)
   return rho;
 }
 
+/// Step 4 of the header: each parameter keeps the larger of its standard errors under `out` and
+/// under the cluster sandwich of B contiguous blocks of the scores.
+void blockCheck(const Eigen::MatrixXd& J, const Eigen::VectorXd& r, const Eigen::MatrixXd& jtj_inv,
+                RingdownCovariance& out) {
+  const int n = static_cast<int>(J.rows()), p = static_cast<int>(J.cols());
+  const int B = std::min(kBlocks, n / 10);
+  if (B < p + 4 || out.rank < p) return;
+  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(p, p);
+  for (int b = 0; b < B; ++b) {
+    const int lo = b * n / B, hi = (b + 1) * n / B;
+    const Eigen::VectorXd s = J.middleRows(lo, hi - lo).transpose() * r.segment(lo, hi - lo);
+    meat += s * s.transpose();
+  }
+  meat *= static_cast<double>(B) / (B - p);
+  const Eigen::MatrixXd cb = jtj_inv * meat * jtj_inv;
+  Eigen::VectorXd sd(p);
+  for (int k = 0; k < p; ++k) {
+    const double a = std::sqrt(std::max(0.0, out.covariance(k, k)));
+    const double b = std::sqrt(std::max(0.0, cb(k, k)));
+    sd(k) = std::max(a, b);
+    if (b > a) ++out.blocks_won;
+  }
+  if (out.blocks_won == 0) return;
+  for (int i = 0; i < p; ++i)
+    for (int j = 0; j < p; ++j) {
+      const double a = std::sqrt(std::max(1e-300, out.covariance(i, i) * out.covariance(j, j)));
+      out.covariance(i, j) = (i == j ? 1.0 : out.covariance(i, j) / a) * sd(i) * sd(j);
+    }
+  out.student_df = std::min(out.student_df, static_cast<double>(B - p));
+  std::ostringstream m;
+  m << "; block check (cluster sandwich of the scores over " << B << " contiguous blocks, the "
+    << "larger std kept per parameter): " << out.blocks_won << " of " << p
+    << " parameters from the blocks, Student df " << B - p;
+  out.method += m.str();
+}
+
 }  // namespace
 
 RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::VectorXd& r) {
+  RingdownCovariance out = ringdownCovarianceModel(J, r);
+  Eigen::MatrixXd jtj_inv = Eigen::MatrixXd::Zero(J.cols(), J.cols());
+  if (out.rank == J.cols()) {
+    Eigen::HouseholderQR<Eigen::MatrixXd> hq(J);
+    const Eigen::MatrixXd R = hq.matrixQR().topRows(J.cols()).triangularView<Eigen::Upper>();
+    const Eigen::MatrixXd Rinv =
+        R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(J.cols(), J.cols()));
+    jtj_inv = Rinv * Rinv.transpose();
+  }
+  blockCheck(J, r, jtj_inv, out);
+  return out;
+}
+
+namespace {
+
+RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r) {
   RingdownCovariance out;
   const int n = static_cast<int>(J.rows()), p = static_cast<int>(J.cols());
   Eigen::HouseholderQR<Eigen::MatrixXd> hq(J);
@@ -87,6 +142,7 @@ RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::Vec
   out.crb = sigma2 * jtj_inv;
   out.covariance = out.crb;
   out.effective_n = n;
+  out.student_df = n - p;
 
   const std::vector<double> rc = autocorrelation(r, kLjungBoxLags);
   out.rho1 = rc[1];
@@ -131,6 +187,7 @@ RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::Vec
   for (int l = 1; l <= L; ++l) c += 2.0 * rho[l];
   out.long_run_factor = std::max(c, 1.0 / n);
   out.effective_n = n / std::max(out.long_run_factor, 1e-3);
+  out.student_df = std::floor(out.effective_n) - p;
   // Meat: sum_{i,j} gamma_|i-j| J_i J_j', gamma_l = var(r) rho_l.
   const double var_r = x.squaredNorm() / std::max(1, n - p);
   Eigen::MatrixXd meat = J.transpose() * J;
@@ -147,4 +204,5 @@ RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::Vec
   return out;
 }
 
+}  // namespace
 }  // namespace cvg_bench

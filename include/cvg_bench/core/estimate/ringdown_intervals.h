@@ -10,6 +10,12 @@
 //    autocorrelation falls below 1e-4; the variance is scaled so that gamma_0 is the residuals'
 //    variance. The effective sample size n / c (c = the long-run variance factor of the model) sets
 //    the Student quantile's degrees of freedom.
+// 4. Block check (whether or not correlation was detected): the cluster sandwich of the scores
+//    J_i' r_i summed over kBlocks contiguous blocks, (J'J)^-1 [B / (B - p) sum_b S_b S_b']
+//    (J'J)^-1, which needs no noise model and holds when the correlation changes along the record
+//    (relative noise at the start, filtered additive noise near the floor) or outlasts an AR(12)
+//    model. Each parameter keeps the larger of its two standard errors (correlations from step
+//    2/3); where the block one wins, the Student quantile has B - p degrees of freedom.
 // The Cramer-Rao bound for white noise (step 2) is returned beside it for the report.
 #pragma once
 
@@ -28,6 +34,8 @@ struct RingdownCovariance {
   std::vector<double> ar;        ///< a_1..a_p of the noise model (empty: white)
   double long_run_factor = 1.0;  ///< 1 + 2 sum rho_l of the noise model
   double effective_n = 0.0;      ///< n / long_run_factor
+  double student_df = 0.0;       ///< degrees of freedom of the Student quantile for intervals
+  int blocks_won = 0;            ///< parameters whose std comes from the block check
   int rank = 0;
   std::string method;  ///< e.g. "AR(3) noise model of the weighted ln A residuals (...)"
 };
