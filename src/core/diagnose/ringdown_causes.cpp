@@ -178,14 +178,10 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     for (size_t i = 0; i < m; ++i)
       e[i] = std::sqrt(f.weight[i]) * (f.log_amplitude[i] - f.fitted[i]);
     double sse = 0.0;
-    for (size_t i = ar.size(); i < m; ++i) {
-      double w = e[i];
-      for (size_t k = 0; k < ar.size(); ++k) w -= ar[k] * e[i - 1 - k];
-      sse += w * w;
-    }
+    for (double w : ringdownArWhiten(ar, e)) sse += w * w;
     return sse;
   };
-  const double n = static_cast<double>(x.baseline.n) - static_cast<double>(ar.size());
+  const double n = static_cast<double>(x.baseline.n);
   const double n_eff = n;
   auto ic = [&](const RingdownFit& f) {
     double pen = f.n_params * std::log(n);

@@ -205,4 +205,39 @@ RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen
 }
 
 }  // namespace
+
+std::vector<double> ringdownArWhiten(const std::vector<double>& ar, const std::vector<double>& e) {
+  const int p = static_cast<int>(ar.size()), n = static_cast<int>(e.size());
+  std::vector<double> w(n);
+  if (p == 0) return e;
+  const std::vector<double> rho = arAutocorrelation(ar, p);
+  // Durbin-Levinson: phi[k] (order k predictor) and v[k] (its error variance / gamma_0).
+  std::vector<std::vector<double>> phi(p);
+  std::vector<double> v(p + 1, 1.0);
+  for (int k = 1; k < p; ++k) {
+    double num = rho[k];
+    for (int j = 1; j < k; ++j) num -= phi[k - 1][j - 1] * rho[k - j];
+    const double kk = v[k - 1] > 0.0 ? num / v[k - 1] : 0.0;
+    phi[k].assign(k, 0.0);
+    for (int j = 1; j < k; ++j) phi[k][j - 1] = phi[k - 1][j - 1] - kk * phi[k - 1][k - j - 1];
+    phi[k][k - 1] = kk;
+    v[k] = v[k - 1] * (1.0 - kk * kk);
+  }
+  // Innovation variance / gamma_0 of the AR model itself: 1 - sum a_k rho_k.
+  double vp = 1.0;
+  for (int k = 1; k <= p; ++k) vp -= ar[k - 1] * rho[k];
+  vp = std::max(vp, 1e-12);
+  for (int i = 0; i < n; ++i) {
+    double pred = 0.0, var = vp;
+    if (i < p) {
+      for (int j = 1; j <= i; ++j) pred += phi[i][j - 1] * e[i - j];
+      var = std::max(v[i], vp);
+    } else {
+      for (int k = 1; k <= p; ++k) pred += ar[k - 1] * e[i - k];
+    }
+    w[i] = (e[i] - pred) * std::sqrt(vp / var);
+  }
+  return w;
+}
+
 }  // namespace cvg_bench

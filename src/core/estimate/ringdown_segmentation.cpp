@@ -246,7 +246,12 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     }
   const size_t m_after = std::min(i_end, i_cross + std::max<size_t>(8, n / 20));
   const double s_after = -slopeOver(t, sm, seg.dropout, i_cross, m_after);
-  seg.has_plateau = s_after > 0.0 && i_cross > 2 && t[i_cross] - t.front() > 3.0 * delta / s_after;
+  // A plateau is flat: the envelope before the crossing falls at under 0.3 of the rate after it
+  // (a record that starts inside a fast first stage of the decay has no plateau; its median level
+  // over the first twentieth is no drive level).
+  const double s_before = -slopeOver(t, sm, seg.dropout, 0, i_cross);
+  seg.has_plateau = s_after > 0.0 && i_cross > 2 &&
+                    t[i_cross] - t.front() > 3.0 * delta / s_after && s_before < 0.3 * s_after;
   seg.drive_off_s = seg.has_plateau ? t[i_cross] - delta / s_after : t.front();
   seg.plateau_log_amplitude = c0;
   const double best_c = c0;

@@ -45,4 +45,11 @@ struct RingdownCovariance {
 RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& jacobian,
                                       const Eigen::VectorXd& residuals);
 
+/// One-step prediction errors of e under the stationary AR noise model a_1..a_p, in units of the
+/// innovation sd (generalized least squares): the first p samples are predicted from the ones
+/// before them only (Durbin-Levinson on the model's autocorrelation) and scaled by their larger
+/// prediction variance, not dropped, so a misfit that starts with the span (a fast first stage
+/// of a decay) keeps its weight; from sample p on, e_i - sum_k a_k e_{i-k}.
+std::vector<double> ringdownArWhiten(const std::vector<double>& ar, const std::vector<double>& e);
+
 }  // namespace cvg_bench

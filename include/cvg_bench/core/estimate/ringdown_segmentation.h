@@ -7,8 +7,10 @@
 //     against the straight decay alone; a floor when it wins (n ln(SSE ratio) > 30) and lies 3 dB
 //     or more above the line's continuation at the end. The decay span ends where the running
 //     median falls to `floor_margin_db` above the floor (the fit includes the floor).
-//  3. Drive switch-off: a hinge (constant, then a straight decline of ln A) fitted by QR on a grid
-//     of switch-off times; the span starts one median interval after the hinge.
+//  3. Drive switch-off: the plateau level is the median of the smoothed envelope over the first
+//     twentieth; the decay starts where the envelope first falls max(6 sd, 0.1 dB) below it. A
+//     plateau needs that crossing late enough and the envelope before it flat (falling at under
+//     0.3 of the rate after it); else the decay starts at the first sample.
 //     Detector settling: the span then starts where the local decay rate first reaches 90 % of the
 //     rate between 3 and 13 dB below the start (a lock-in's low-pass rounds the corner; at most
 //     the first 3 dB are skipped).
