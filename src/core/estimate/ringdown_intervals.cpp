@@ -109,8 +109,10 @@ void blockCheck(const Eigen::MatrixXd& J, const Eigen::VectorXd& r, const Eigen:
 
 }  // namespace
 
-RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::VectorXd& r) {
+RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
+                                      bool block_check) {
   RingdownCovariance out = ringdownCovarianceModel(J, r);
+  if (!block_check) return out;
   Eigen::MatrixXd jtj_inv = Eigen::MatrixXd::Zero(J.cols(), J.cols());
   if (out.rank == J.cols()) {
     Eigen::HouseholderQR<Eigen::MatrixXd> hq(J);

@@ -42,8 +42,10 @@ struct RingdownCovariance {
 
 /// jacobian: n x p of the weighted model, rows in time order; residuals: the n weighted residuals
 /// (sigma^2 = SSE / (n - p)).
+/// block_check: step 4 (intervals); false gives steps 1-3 only (the lack-of-fit test, whose power
+/// against a misfit localized in time the blocks would absorb).
 RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& jacobian,
-                                      const Eigen::VectorXd& residuals);
+                                      const Eigen::VectorXd& residuals, bool block_check = true);
 
 /// One-step prediction errors of e under the stationary AR noise model a_1..a_p, in units of the
 /// innovation sd (generalized least squares): the first p samples are predicted from the ones

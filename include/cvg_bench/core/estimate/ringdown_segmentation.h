@@ -11,9 +11,9 @@
 //     twentieth; the decay starts where the envelope first falls max(6 sd, 0.1 dB) below it. A
 //     plateau needs that crossing late enough and the envelope before it flat (falling at under
 //     0.3 of the rate after it); else the decay starts at the first sample.
-//     Detector settling: the span then starts where the local decay rate first reaches 90 % of the
-//     rate between 3 and 13 dB below the start (a lock-in's low-pass rounds the corner; at most
-//     the first 3 dB are skipped).
+//     Detector settling: the span then starts at the drive-off plus twice the time the local decay
+//     rate takes to peak within the first 3 dB (a lock-in's low-pass rounds the corner; at most the
+//     first 3 dB are skipped).
 //  4. Refusal: under 3 dB (or 10 robust sd) of decay, or under 8 samples in the span.
 #pragma once
 
