@@ -237,10 +237,14 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
   for (size_t i = 0; i < std::max<size_t>(5, n / 20) && i < n; ++i)
     if (std::isfinite(sm[i])) head.push_back(sm[i]);
   const double c0 = median(head);
+  // The crossing is taken below the head's 5th percentile: a plateau that beats (two close modes
+  // driven together) dips below its median every beat period.
+  std::sort(head.begin(), head.end());
+  const double c_low = head.empty() ? c0 : head[head.size() / 20];
   const double delta = std::max(6.0 * seg.noise_sd_log, 0.1 / kDbPerNeper);
   size_t i_cross = 0;
   for (size_t i = 0; i < i_end; ++i)
-    if (std::isfinite(sm[i]) && sm[i] < c0 - delta) {
+    if (std::isfinite(sm[i]) && sm[i] < c_low - delta) {
       i_cross = i;
       break;
     }

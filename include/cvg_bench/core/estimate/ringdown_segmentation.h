@@ -8,7 +8,8 @@
 //     or more above the line's continuation at the end. The decay span ends where the running
 //     median falls to `floor_margin_db` above the floor (the fit includes the floor).
 //  3. Drive switch-off: the plateau level is the median of the smoothed envelope over the first
-//     twentieth; the decay starts where the envelope first falls max(6 sd, 0.1 dB) below it. A
+//     twentieth; the decay starts where the envelope first falls max(6 sd, 0.1 dB) below its 5th
+//     percentile there (a beating plateau dips below its median). A
 //     plateau needs that crossing late enough and the envelope before it flat (falling at under
 //     0.3 of the rate after it); else the decay starts at the first sample.
 //     Detector settling: the span then starts at the drive-off plus twice the time the local decay
