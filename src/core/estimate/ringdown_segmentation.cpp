@@ -250,12 +250,21 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     }
   const size_t m_after = std::min(i_end, i_cross + std::max<size_t>(8, n / 20));
   const double s_after = -slopeOver(t, sm, seg.dropout, i_cross, m_after);
-  // A plateau is flat: the envelope before the crossing falls at under 0.3 of the rate after it
-  // (a record that starts inside a fast first stage of the decay has no plateau; its median level
-  // over the first twentieth is no drive level).
+  // A plateau does not fall steadily at 0.3 or more of the rate after the crossing (a record that
+  // starts inside a fast first stage of the decay has no plateau; its median level over the first
+  // twentieth is no drive level). Falling means steadily: 90 % of the differences over a tenth of
+  // the stretch negative (a beating plateau falls and rises).
   const double s_before = -slopeOver(t, sm, seg.dropout, 0, i_cross);
-  seg.has_plateau = s_after > 0.0 && i_cross > 2 &&
-                    t[i_cross] - t.front() > 3.0 * delta / s_after && s_before < 0.3 * s_after;
+  bool falling = false;
+  {
+    const size_t lag = std::max<size_t>(1, i_cross / 10);
+    size_t down = 0, all = 0;
+    for (size_t i = 0; i + lag < i_cross; ++i)
+      if (std::isfinite(sm[i]) && std::isfinite(sm[i + lag])) ++all, down += sm[i + lag] < sm[i];
+    falling = all > 0 && down >= 0.9 * all && s_before >= 0.3 * s_after;
+  }
+  seg.has_plateau =
+      s_after > 0.0 && i_cross > 2 && t[i_cross] - t.front() > 3.0 * delta / s_after && !falling;
   seg.drive_off_s = seg.has_plateau ? t[i_cross] - delta / s_after : t.front();
   seg.plateau_log_amplitude = c0;
   const double best_c = c0;

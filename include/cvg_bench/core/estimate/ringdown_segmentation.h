@@ -10,8 +10,9 @@
 //  3. Drive switch-off: the plateau level is the median of the smoothed envelope over the first
 //     twentieth; the decay starts where the envelope first falls max(6 sd, 0.1 dB) below its 5th
 //     percentile there (a beating plateau dips below its median). A
-//     plateau needs that crossing late enough and the envelope before it flat (falling at under
-//     0.3 of the rate after it); else the decay starts at the first sample.
+//     plateau needs that crossing late enough and the envelope before it not falling steadily
+//     (90 % of its differences over a tenth of the stretch negative and the mean rate over 0.3 of
+//     the rate after the crossing); else the decay starts at the first sample.
 //     Detector settling: the span then starts at the drive-off plus twice the time the local decay
 //     rate takes to peak within the first 3 dB (a lock-in's low-pass rounds the corner; at most the
 //     first 3 dB are skipped).
