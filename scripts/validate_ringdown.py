@@ -24,7 +24,8 @@ Thresholds (fixed before running): Q coverage of the 95 % interval in [0.90, 0.9
 detected (the right name selected; det_loss: `unexplained`) in >= 95 %; false alarms on clean
 records (any extension selected or `unexplained`) <= 5 %; floor found in >= 95 % of records with a
 floor and claimed in <= 5 % without. Rates carry Wilson 95 % intervals. Tuning runs use other seed
-bases than the reporting run (`--seed-base`; the reporting base is the default).
+bases than the reporting run (`--seed-base`; the reporting base is the default, 71829304, first
+used after tuning on bases 41000000, 42000000 and 43000000; 20261125 and 30261125 are spent).
 
 Usage: validate_ringdown.py [--markdown FILE] [--n N] [--seed-base S] [--classes a,b] [--jobs J]
 """
@@ -46,6 +47,19 @@ CLASSES = ["clean", "gamma_nl", "gamma_a", "beat", "two_stage", "det_loss"]
 COVERAGE_RANGE = (0.90, 0.98)
 DETECTION_MIN = 0.95
 FALSE_ALARM_MAX = 0.05
+
+
+NOTES = """Method notes. Q was 1-5 % high on records with a floor because the additive-noise
+weights were taken at each sample's observed (5-point smoothed) level: a sample lifted by noise read
+as quieter and weighed more, pulling the tail up (mean z of Q on floor records +0.65 on tuning base
+41000000). The weights now come from a degree-6 Legendre smooth of the whole span (leverage 7 / n per
+sample; the same for every model so criteria compare): mean z +0.3. The floor itself is in the model
+(Rice mean of ln|A + n|) and the fit stops 10 dB above it, where that term is under 1e-5 Np.
+The remaining miss was width: the AR(p <= 12) sandwich assumes one stationary correlation, while the
+records carry relative noise early and the lock-in-filtered floor noise late. Each parameter's std is
+now the larger of the AR sandwich and a cluster sandwich of the scores over 16 contiguous blocks
+(Student df 16 - p where the blocks win); `interval_method` names both. The lack-of-fit test keeps
+the AR covariance alone (the blocks absorb a misfit localized in time)."""
 
 
 def wilson(k, n, z=1.96):
@@ -250,7 +264,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--markdown")
     ap.add_argument("--n", type=int, default=20, help="records per class")
-    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=30261125,
+    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=71829304,
                     help="first seed (the reporting run uses the default; tune on others)")
     ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated subset")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("VALIDATE_JOBS", "2")))
@@ -324,12 +338,12 @@ def main():
           "and switched off, read through a simulated lock-in (2-pole low-pass, 0.8 .. 3 cycles) with "
           "white noise at its input (the floor, correlated after the filter) and AR(1) relative noise "
           "(coefficient up to 0.85); plateau, floor, drop-outs, three instrument formats, amplitude "
-          "scale 1e-5 .. 10. %d records per class, seed base %d (the tuning runs used other bases); "
+          "scale 1e-5 .. 10. %d records per class, seed base %d (tuning used bases 41000000, 42000000, 43000000); "
           "thresholds fixed in the script before the run. Tool: `cvg_ident explain INPUT --mode "
           "ringdown --json`. Command: `%s`." % (a.n, a.seed, " ".join(["scripts/validate_ringdown.py"] + sys.argv[1:])), "",
           "| check | count | rate | Wilson 95 % | target | |", "|---|---|---|---|---|---|"] + rows + [
           "", "Secondary (no target):", "", "| figure | count | rate | Wilson 95 % |", "|---|---|---|---|"] + extra + [
-          "", "Interval std (AR noise-model sandwich, or white when no correlation is detected) / Cramer-Rao std of Q on clean records: median %.2f, 10-90 %% %.2f .. %.2f "
+          "", "Interval std (AR noise-model sandwich, or white when no correlation is detected, each parameter widened to the block check's cluster sandwich over 16 blocks where that is larger) / Cramer-Rao std of Q on clean records: median %.2f, 10-90 %% %.2f .. %.2f "
           "(the bound assumes white noise; the records' noise is coloured)." % (
               float(np.median(ratios)), float(np.percentile(ratios, 10)), float(np.percentile(ratios, 90)))
           if ratios else "", "",
@@ -338,7 +352,8 @@ def main():
                                                          rc_fail[0]["kind"], rc_fail[0].get("err", "")[:150]))),
           "Time per record (explain, 1500-4000 samples): median %.2f s, max %.2f s; wall %.0f s with %d jobs." % (
               times[len(times) // 2], times[-1], wall, a.jobs), "",
-          "Verdict: **%s**" % ("all targets met" if verdict_ok else "some targets missed (FAIL rows)")]
+          "Verdict: **%s**" % ("all targets met" if verdict_ok else "some targets missed (FAIL rows)"), "",
+          NOTES]
     text = "\n".join(md) + "\n"
     print(text)
     if a.markdown:

@@ -174,43 +174,63 @@ std::vector<Eigen::VectorXd> ringdownStarts(const std::string& model, const Ring
   } else if (model == "beat") {
     // Residual periodogram of the linear fit: peaks between 1.5 cycles per span and a quarter of
     // the sample rate (at most 256 cycles per span) give the split w; the modulation depth m
-    // gives A2/A1 ~ m. The residuals are averaged into at most 1024 equal time bins first.
+    // gives A2/A1 ~ m. The residuals are averaged into at most 1024 equal time bins first. Two
+    // periodograms: of the residuals as they are, and weighted by the error model (the quiet
+    // start counts more than the noisy end near the floor), and of the first 40 % of the span only
+    // (a second mode that decays faster modulates the start alone); the highest peaks of each.
     const int n = static_cast<int>(lin.t_s.size());
     const int nb = std::min(n, 1024);
-    std::vector<double> tt(nb, 0.0), rr(nb, 0.0);
-    std::vector<int> cnt(nb, 0);
-    for (int i = 0; i < n; ++i) {
-      const double tn = (lin.t_s[i] - lin.t_ref_s) / lin.t_scale_s;
-      const int b = std::min(nb - 1, std::max(0, static_cast<int>(tn * nb)));
-      tt[b] += tn, rr[b] += lin.log_amplitude[i] - lin.fitted[i], ++cnt[b];
-    }
-    int m_used = 0;
-    for (int b = 0; b < nb; ++b)
-      if (cnt[b] > 0) tt[m_used] = tt[b] / cnt[b], rr[m_used] = rr[b] / cnt[b], ++m_used;
-    tt.resize(m_used), rr.resize(m_used);
-    const double w_max = M_PI * m_used / 2.0;
-    std::vector<std::pair<double, double>> peaks;  // power, w
-    double prev2 = 0, prev1 = 0, w_prev = 0;
-    const double dw = M_PI / 4.0;
-    for (double w = 1.5 * 2 * M_PI; w < w_max; w += dw) {
-      double c = 0, sn = 0;
-      for (int i = 0; i < m_used; ++i)
-        c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
-      const double pw = c * c + sn * sn;
-      if (prev1 > prev2 && prev1 >= pw) peaks.emplace_back(prev1, w_prev);
-      prev2 = prev1, prev1 = pw, w_prev = w;
-    }
-    std::sort(peaks.rbegin(), peaks.rend());
-    for (size_t k = 0; k < std::min<size_t>(3, peaks.size()); ++k) {
-      const double w = peaks[k].second;
-      double c = 0, sn = 0;
-      for (int i = 0; i < m_used; ++i)
-        c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
-      const double m = std::min(0.9, std::max(1e-3, 2.0 * std::sqrt(c * c + sn * sn) / m_used));
-      const double phi = std::atan2(-sn, c);
-      Eigen::VectorXd p(6);
-      p << a, g, a + std::log(m), g, w, phi;
-      s.push_back(p);
+    std::vector<double> seen;
+    for (int variant = 0; variant < 3; ++variant) {
+      const bool weighted = variant == 1;
+      const double t_cut = variant == 2 ? 0.4 : 1.0;
+      std::vector<double> tt(nb, 0.0), rr(nb, 0.0), ww(nb, 0.0);
+      std::vector<int> cnt(nb, 0);
+      for (int i = 0; i < n; ++i) {
+        const double tn = (lin.t_s[i] - lin.t_ref_s) / lin.t_scale_s;
+        if (tn > t_cut) break;
+        const int b = std::min(nb - 1, std::max(0, static_cast<int>(tn / t_cut * nb)));
+        const double wt = weighted && i < static_cast<int>(lin.weight.size()) ? lin.weight[i] : 1.0;
+        tt[b] += tn, rr[b] += wt * (lin.log_amplitude[i] - lin.fitted[i]), ww[b] += wt, ++cnt[b];
+      }
+      int m_used = 0;
+      double w_sum = 0.0;
+      for (int b = 0; b < nb; ++b)
+        if (cnt[b] > 0) {
+          tt[m_used] = tt[b] / cnt[b], rr[m_used] = rr[b] / cnt[b], ww[m_used] = ww[b] / cnt[b];
+          w_sum += ww[m_used], ++m_used;
+        }
+      tt.resize(m_used), rr.resize(m_used);
+      const double w_max = M_PI * m_used / 2.0;
+      std::vector<std::pair<double, double>> peaks;  // power, w
+      double prev2 = 0, prev1 = 0, w_prev = 0;
+      const double dw = M_PI / 4.0;
+      for (double w = 1.5 * 2 * M_PI; w < w_max; w += dw) {
+        double c = 0, sn = 0;
+        for (int i = 0; i < m_used; ++i)
+          c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
+        const double pw = c * c + sn * sn;
+        if (prev1 > prev2 && prev1 >= pw) peaks.emplace_back(prev1, w_prev);
+        prev2 = prev1, prev1 = pw, w_prev = w;
+      }
+      std::sort(peaks.rbegin(), peaks.rend());
+      int taken = 0;
+      for (size_t k = 0; k < peaks.size() && taken < (variant == 0 ? 3 : 2); ++k) {
+        const double w = peaks[k].second;
+        bool dup = false;
+        for (double v : seen) dup |= std::fabs(v - w) < 1.5 * dw;
+        if (dup) continue;
+        seen.push_back(w), ++taken;
+        double c = 0, sn = 0;
+        for (int i = 0; i < m_used; ++i)
+          c += rr[i] * std::cos(w * tt[i]), sn += rr[i] * std::sin(w * tt[i]);
+        const double norm = weighted ? std::max(w_sum, 1e-300) : m_used;
+        const double m = std::min(0.9, std::max(1e-3, 2.0 * std::sqrt(c * c + sn * sn) / norm));
+        const double phi = std::atan2(-sn, c);
+        Eigen::VectorXd p(6);
+        p << a, g, a + std::log(m), g, w, phi;
+        s.push_back(p);
+      }
     }
     if (s.empty()) {
       Eigen::VectorXd p(6);
@@ -336,6 +356,33 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
     const double lvl = acc / c;
     d.w(i) = 1.0 / (s_m2 + s_a2 * std::exp(-2.0 * lvl));
   }
+  // Weights at the observed level correlate with the noise of the same samples (a sample lifted
+  // by noise reads as quieter and weighs more), which pulls the tail up and the rate down under
+  // additive noise (Q 1-5 % high). The level for the weights is therefore a smooth of the whole
+  // span instead: a weighted Legendre polynomial of degree 6 in time (leverage 7 / n per sample),
+  // refitted once with its own weights. The same for every model, so criteria compare.
+  if (additive && n > 40) {
+    for (int pass = 0; pass < 2; ++pass) {
+      const int deg = 6;
+      Eigen::MatrixXd X(n, deg + 1);
+      Eigen::VectorXd Y(n);
+      for (int i = 0; i < n; ++i) {
+        const double sw = std::sqrt(d.w(i)), x = 2.0 * d.t(i) - 1.0;
+        double p0 = 1.0, p1 = x;
+        X(i, 0) = sw, X(i, 1) = sw * x;
+        for (int k = 2; k <= deg; ++k) {
+          const double p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
+          X(i, k) = sw * p2, p0 = p1, p1 = p2;
+        }
+        Y(i) = sw * d.y(i);
+      }
+      const Eigen::VectorXd c = X.colPivHouseholderQr().solve(Y);
+      for (int i = 0; i < n; ++i) {
+        const double lvl = X.row(i).dot(c) / std::sqrt(d.w(i));
+        d.w(i) = 1.0 / (s_m2 + s_a2 * std::exp(-2.0 * lvl));
+      }
+    }
+  }
   // Normalize the weights to mean 1 (sigma then reads in units of the mean sd).
   d.w /= d.w.mean();
 
@@ -419,8 +466,8 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
   fit.long_run_factor = rc.long_run_factor;
   fit.effective_n = rc.effective_n;
   fit.interval_method = rc.method + "; " + fit.error_model + " error model";
-  const double z = studentQuantile(
-      options.confidence, std::max(1, static_cast<int>(std::floor(fit.effective_n)) - p_n));
+  const double z =
+      studentQuantile(options.confidence, std::max(1, static_cast<int>(rc.student_df)));
 
   // Physical values. Time scale T: rates in 1/T -> 1/s divide by T.
   const double T = fit.t_scale_s;
@@ -520,8 +567,8 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
       const Eigen::VectorXd res = Y - X * c;
       const RingdownCovariance hb = ringdownCovariance(X, res);
       RingdownValue rate;
-      const double zb = studentQuantile(
-          options.confidence, std::max(1, static_cast<int>(std::floor(hb.effective_n)) - 2));
+      const double zb =
+          studentQuantile(options.confidence, std::max(1, static_cast<int>(hb.student_df)));
       rate.value = c(1) / ts;  // in 1/T
       rate.std = std::sqrt(std::max(0.0, hb.covariance(1, 1))) / ts;
       rate.ci_low = rate.value - zb * rate.std, rate.ci_high = rate.value + zb * rate.std;

@@ -10,6 +10,9 @@ namespace {
 
 constexpr int kMaxArOrder = 12;
 constexpr int kLjungBoxLags = 10;
+constexpr int kBlocks = 16;
+
+RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r);
 
 /// Autocorrelations r_1..r_L of x (mean removed).
 std::vector<double> autocorrelation(const Eigen::VectorXd& x, int lags) {
@@ -68,9 +71,63 @@ std::vector<double> arAutocorrelation(const std::vector<double>& a, int max_lag)
   return rho;
 }
 
+/// Step 4 of the header: each parameter keeps the larger of its standard errors under `out` and
+/// under the cluster sandwich of B contiguous blocks of the scores.
+void blockCheck(const Eigen::MatrixXd& J, const Eigen::VectorXd& r, const Eigen::MatrixXd& jtj_inv,
+                RingdownCovariance& out) {
+  const int n = static_cast<int>(J.rows()), p = static_cast<int>(J.cols());
+  const int B = std::min(kBlocks, n / 10);
+  if (B < p + 4 || out.rank < p) return;
+  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(p, p);
+  for (int b = 0; b < B; ++b) {
+    const int lo = b * n / B, hi = (b + 1) * n / B;
+    const Eigen::VectorXd s = J.middleRows(lo, hi - lo).transpose() * r.segment(lo, hi - lo);
+    meat += s * s.transpose();
+  }
+  meat *= static_cast<double>(B) / (B - p);
+  const Eigen::MatrixXd cb = jtj_inv * meat * jtj_inv;
+  Eigen::VectorXd sd(p);
+  for (int k = 0; k < p; ++k) {
+    const double a = std::sqrt(std::max(0.0, out.covariance(k, k)));
+    const double b = std::sqrt(std::max(0.0, cb(k, k)));
+    sd(k) = std::max(a, b);
+    if (b > a) ++out.blocks_won;
+  }
+  if (out.blocks_won == 0) return;
+  for (int i = 0; i < p; ++i)
+    for (int j = 0; j < p; ++j) {
+      const double a = std::sqrt(std::max(1e-300, out.covariance(i, i) * out.covariance(j, j)));
+      out.covariance(i, j) = (i == j ? 1.0 : out.covariance(i, j) / a) * sd(i) * sd(j);
+    }
+  out.student_df = std::min(out.student_df, static_cast<double>(B - p));
+  std::ostringstream m;
+  m << "; block check (cluster sandwich of the scores over " << B << " contiguous blocks, the "
+    << "larger std kept per parameter): " << out.blocks_won << " of " << p
+    << " parameters from the blocks, Student df " << B - p;
+  out.method += m.str();
+}
+
 }  // namespace
 
-RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::VectorXd& r) {
+RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
+                                      bool block_check) {
+  RingdownCovariance out = ringdownCovarianceModel(J, r);
+  if (!block_check) return out;
+  Eigen::MatrixXd jtj_inv = Eigen::MatrixXd::Zero(J.cols(), J.cols());
+  if (out.rank == J.cols()) {
+    Eigen::HouseholderQR<Eigen::MatrixXd> hq(J);
+    const Eigen::MatrixXd R = hq.matrixQR().topRows(J.cols()).triangularView<Eigen::Upper>();
+    const Eigen::MatrixXd Rinv =
+        R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(J.cols(), J.cols()));
+    jtj_inv = Rinv * Rinv.transpose();
+  }
+  blockCheck(J, r, jtj_inv, out);
+  return out;
+}
+
+namespace {
+
+RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r) {
   RingdownCovariance out;
   const int n = static_cast<int>(J.rows()), p = static_cast<int>(J.cols());
   Eigen::HouseholderQR<Eigen::MatrixXd> hq(J);
@@ -87,6 +144,7 @@ RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::Vec
   out.crb = sigma2 * jtj_inv;
   out.covariance = out.crb;
   out.effective_n = n;
+  out.student_df = n - p;
 
   const std::vector<double> rc = autocorrelation(r, kLjungBoxLags);
   out.rho1 = rc[1];
@@ -131,6 +189,7 @@ RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::Vec
   for (int l = 1; l <= L; ++l) c += 2.0 * rho[l];
   out.long_run_factor = std::max(c, 1.0 / n);
   out.effective_n = n / std::max(out.long_run_factor, 1e-3);
+  out.student_df = std::floor(out.effective_n) - p;
   // Meat: sum_{i,j} gamma_|i-j| J_i J_j', gamma_l = var(r) rho_l.
   const double var_r = x.squaredNorm() / std::max(1, n - p);
   Eigen::MatrixXd meat = J.transpose() * J;
@@ -145,6 +204,42 @@ RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::Vec
     << out.long_run_factor << ", " << L << " lags): sandwich (J'J)^-1 J' Sigma_AR J (J'J)^-1";
   out.method = m.str();
   return out;
+}
+
+}  // namespace
+
+std::vector<double> ringdownArWhiten(const std::vector<double>& ar, const std::vector<double>& e) {
+  const int p = static_cast<int>(ar.size()), n = static_cast<int>(e.size());
+  std::vector<double> w(n);
+  if (p == 0) return e;
+  const std::vector<double> rho = arAutocorrelation(ar, p);
+  // Durbin-Levinson: phi[k] (order k predictor) and v[k] (its error variance / gamma_0).
+  std::vector<std::vector<double>> phi(p);
+  std::vector<double> v(p + 1, 1.0);
+  for (int k = 1; k < p; ++k) {
+    double num = rho[k];
+    for (int j = 1; j < k; ++j) num -= phi[k - 1][j - 1] * rho[k - j];
+    const double kk = v[k - 1] > 0.0 ? num / v[k - 1] : 0.0;
+    phi[k].assign(k, 0.0);
+    for (int j = 1; j < k; ++j) phi[k][j - 1] = phi[k - 1][j - 1] - kk * phi[k - 1][k - j - 1];
+    phi[k][k - 1] = kk;
+    v[k] = v[k - 1] * (1.0 - kk * kk);
+  }
+  // Innovation variance / gamma_0 of the AR model itself: 1 - sum a_k rho_k.
+  double vp = 1.0;
+  for (int k = 1; k <= p; ++k) vp -= ar[k - 1] * rho[k];
+  vp = std::max(vp, 1e-12);
+  for (int i = 0; i < n; ++i) {
+    double pred = 0.0, var = vp;
+    if (i < p) {
+      for (int j = 1; j <= i; ++j) pred += phi[i][j - 1] * e[i - j];
+      var = std::max(v[i], vp);
+    } else {
+      for (int k = 1; k <= p; ++k) pred += ar[k - 1] * e[i - k];
+    }
+    w[i] = (e[i] - pred) * std::sqrt(vp / var);
+  }
+  return w;
 }
 
 }  // namespace cvg_bench

@@ -237,24 +237,45 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
   for (size_t i = 0; i < std::max<size_t>(5, n / 20) && i < n; ++i)
     if (std::isfinite(sm[i])) head.push_back(sm[i]);
   const double c0 = median(head);
+  // The crossing is taken below the head's 5th percentile: a plateau that beats (two close modes
+  // driven together) dips below its median every beat period.
+  std::sort(head.begin(), head.end());
+  const double c_low = head.empty() ? c0 : head[head.size() / 20];
   const double delta = std::max(6.0 * seg.noise_sd_log, 0.1 / kDbPerNeper);
   size_t i_cross = 0;
   for (size_t i = 0; i < i_end; ++i)
-    if (std::isfinite(sm[i]) && sm[i] < c0 - delta) {
+    if (std::isfinite(sm[i]) && sm[i] < c_low - delta) {
       i_cross = i;
       break;
     }
   const size_t m_after = std::min(i_end, i_cross + std::max<size_t>(8, n / 20));
   const double s_after = -slopeOver(t, sm, seg.dropout, i_cross, m_after);
-  seg.has_plateau = s_after > 0.0 && i_cross > 2 && t[i_cross] - t.front() > 3.0 * delta / s_after;
+  // A plateau does not fall steadily at 0.3 or more of the rate after the crossing (a record that
+  // starts inside a fast first stage of the decay has no plateau; its median level over the first
+  // twentieth is no drive level). Falling means steadily: 90 % of the differences over a tenth of
+  // the stretch negative (a beating plateau falls and rises).
+  const double s_before = -slopeOver(t, sm, seg.dropout, 0, i_cross);
+  bool falling = false;
+  {
+    const size_t lag = std::max<size_t>(1, i_cross / 10);
+    size_t down = 0, all = 0;
+    for (size_t i = 0; i + lag < i_cross; ++i)
+      if (std::isfinite(sm[i]) && std::isfinite(sm[i + lag])) ++all, down += sm[i + lag] < sm[i];
+    falling = all > 0 && down >= 0.9 * all && s_before >= 0.3 * s_after;
+  }
+  seg.has_plateau =
+      s_after > 0.0 && i_cross > 2 && t[i_cross] - t.front() > 3.0 * delta / s_after && !falling;
   seg.drive_off_s = seg.has_plateau ? t[i_cross] - delta / s_after : t.front();
   seg.plateau_log_amplitude = c0;
   const double best_c = c0;
   size_t i_start = seg.has_plateau ? i_cross : 0;
   // Detector settling: a lock-in or video filter rounds the corner at switch-off, so the decay rate
-  // starts near zero. The span starts where the local rate (over w samples) first reaches 90 % of
-  // the rate between 3 and 13 dB below the start (at most the first 3 dB of decay are skipped;
-  // damping that grows with amplitude makes the early rate higher, so nothing is skipped then).
+  // starts near zero and rises over a few filter time constants while the true rate may already be
+  // falling (damping that grows with the amplitude, a fast first stage). The local rate (over
+  // n / 80 samples) peaks once the filter has nearly caught up; the span starts at the drive-off
+  // plus twice the time to that peak, where the filter's transient has decayed (a 2-pole filter
+  // leaves ~1 dB at the corner, 0.25 dB after 2.5 time constants, 0.03 dB after 5). At most the
+  // first 3 dB of decay are skipped.
   if (i_end > i_start + 40) {
     const double s0 = sm[i_start];
     size_t a3 = i_end, a13 = i_end;
@@ -267,12 +288,18 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
       }
     }
     if (a3 < i_end && a13 > a3 + 8) {
-      const double ref = slopeOver(t, sm, seg.dropout, a3, a13);
-      const size_t w = std::max<size_t>(8, n / 200);
+      // Time of the peak local rate within the first 3 dB (window centre).
+      const size_t w = std::max<size_t>(8, n / 80);
+      double peak = slopeOver(t, sm, seg.dropout, a3, a13);  // negative: ln A falls
+      double t_peak = seg.drive_off_s;
       for (size_t i = i_start; i + w < a3; ++i) {
-        if (slopeOver(t, sm, seg.dropout, i, i + w) <= 0.9 * ref) break;
-        i_start = i + 1;
+        const double sl = slopeOver(t, sm, seg.dropout, i, i + w);
+        if (sl < peak) peak = sl, t_peak = 0.5 * (t[i] + t[i + w - 1]);
       }
+      const double t_skip = seg.drive_off_s + 2.0 * std::max(0.0, t_peak - seg.drive_off_s);
+      size_t i_new = i_start;
+      while (i_new < a3 && t[i_new] < t_skip) ++i_new;
+      i_start = i_new;
     }
   }
   if (i_end <= i_start + 8) throw AnalysisError("ring-down: no decay above the noise floor");

@@ -77,6 +77,25 @@ TEST(RingdownCauses, TwoStageDecay) {
   EXPECT_EQ(x.selected.front(), "two_stage") << x.cause;
 }
 
+// A record that starts inside the fast first stage (no plateau): its median level over the first
+// twentieth is no drive level, and the fast stage's misfit sits in the span's first samples, which
+// the AR-whitened criterion keeps.
+TEST(RingdownCauses, TwoStageDecayWithoutPlateau) {
+  RingdownSimulationOptions o = bench(17);
+  o.plateau_s = 0.0;
+  o.two_stage_ratio = 3.0;
+  o.q_fast = 1.0e4;
+  const RingdownExplanation x = explainOf(o);
+  EXPECT_FALSE(x.segment.has_plateau);
+  EXPECT_LT(x.segment.t_start_s, 0.02 * (x.segment.t_end_s - x.segment.t_start_s));
+  ASSERT_EQ(x.selected.size(), 1u) << x.cause;
+  EXPECT_EQ(x.selected.front(), "two_stage") << x.cause;
+  // The slow stage is the mode: Q within its interval widened by one sd.
+  const RingdownValue& q = x.final_fit.derived.at("Q");
+  EXPECT_GT(o.q, q.ci_low - q.std);
+  EXPECT_LT(o.q, q.ci_high + q.std);
+}
+
 TEST(RingdownCauses, DetectionLossIsUnexplainedNotADampingLaw) {
   RingdownSimulationOptions o = bench(16);
   o.detection_loss_db = 8.0;

@@ -82,6 +82,27 @@ TEST(RingdownFit, ErrorModelIsChosenFromTheData) {
   EXPECT_EQ(fitOf(simulateRingdown(o)).error_model, "additive");
 }
 
+// Two close modes each driven at its own frequency beat on the plateau as well: the decay starts
+// after the plateau (drive off at 10 s), not at the plateau's first dip below its median.
+TEST(RingdownFit, BeatingPlateauKeepsTheDriveOff) {
+  RingdownEnvelope env;
+  env.frequency_hz = 1.0e4;
+  const double t_off = 10.0, g = 0.1, split = 0.7, r2 = 0.3;
+  for (int i = 0; i < 2000; ++i) {
+    const double t = 0.05 * i, td = std::max(0.0, t - t_off);
+    const double a2 = r2 * std::exp(-1.2 * g * td), ph = 2.0 * M_PI * split * t;
+    const double p = std::exp(-2 * g * td) + a2 * a2 + 2 * a2 * std::exp(-g * td) * std::cos(ph);
+    env.t_s.push_back(t);
+    env.log_amplitude.push_back(0.5 * std::log(p) + 1e-3 * std::sin(12.3 * i));
+  }
+  const RingdownSegment seg = segmentRingdown(env);
+  EXPECT_TRUE(seg.has_plateau);
+  EXPECT_GT(seg.t_start_s, t_off);
+  // The crossing lies below the plateau's deepest dips (-3.1 dB), then at most 3 dB are skipped
+  // for settling: 6.1 dB, 7 s at 0.1 1/s.
+  EXPECT_LT(seg.t_start_s, t_off + 7.5);
+}
+
 TEST(RingdownFit, NoDecayIsRefused) {
   RingdownSimulationOptions o = bench();
   o.q = 1e9;  // tau 3e4 s over a 60 s record

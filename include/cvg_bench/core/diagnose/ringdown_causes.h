@@ -13,7 +13,8 @@
 // law's coefficient positive (sign check), else the law is not physical; a beat or a two-stage
 // decay must also lie `law_margin` below every physical amplitude law (they can bend a decay the
 // same way with more parameters). The lowest criterion wins and is confirmed on hold-out (blocked
-// two-fold prediction error below the single exponential's and the rival law's). An amplitude law
+// two-fold prediction error below the single exponential's and the rival law's; for a beat or a
+// two-stage decay below 0.9 of it). An amplitude law
 // with a negative coefficient that beats every physical model by the margin means the decay
 // accelerates as it falls: "unexplained". The final model's lack of fit: Wald test of Legendre
 // polynomials P2..P5 in time added to its residuals, covariance under the residuals' AR model.

@@ -7,11 +7,15 @@
 //     against the straight decay alone; a floor when it wins (n ln(SSE ratio) > 30) and lies 3 dB
 //     or more above the line's continuation at the end. The decay span ends where the running
 //     median falls to `floor_margin_db` above the floor (the fit includes the floor).
-//  3. Drive switch-off: a hinge (constant, then a straight decline of ln A) fitted by QR on a grid
-//     of switch-off times; the span starts one median interval after the hinge.
-//     Detector settling: the span then starts where the local decay rate first reaches 90 % of the
-//     rate between 3 and 13 dB below the start (a lock-in's low-pass rounds the corner; at most
-//     the first 3 dB are skipped).
+//  3. Drive switch-off: the plateau level is the median of the smoothed envelope over the first
+//     twentieth; the decay starts where the envelope first falls max(6 sd, 0.1 dB) below its 5th
+//     percentile there (a beating plateau dips below its median). A
+//     plateau needs that crossing late enough and the envelope before it not falling steadily
+//     (90 % of its differences over a tenth of the stretch negative and the mean rate over 0.3 of
+//     the rate after the crossing); else the decay starts at the first sample.
+//     Detector settling: the span then starts at the drive-off plus twice the time the local decay
+//     rate takes to peak within the first 3 dB (a lock-in's low-pass rounds the corner; at most the
+//     first 3 dB are skipped).
 //  4. Refusal: under 3 dB (or 10 robust sd) of decay, or under 8 samples in the span.
 #pragma once
 
