@@ -100,16 +100,15 @@ void printSummary(const Explanation& x) {
   for (const auto& s : x.selection.steps)
     std::cout << "  + " << std::left << std::setw(9) << s.added << std::right << " sigma "
               << s.sigma << "  ratio " << s.sigma_ratio << "  F " << s.wald.f_statistic << "  p "
-              << s.wald.p_value << "  dIC " << s.delta_criterion << "  hold-out "
-              << s.holdout_ratio << "\n";
+              << s.wald.p_value << "  dIC " << s.delta_criterion << "  hold-out " << s.holdout_ratio
+              << "\n";
   for (const auto& s : x.selection.last_round)
     std::cout << "    (not accepted: +" << s.added << ", dIC " << s.delta_criterion << ", p "
               << s.wald.p_value << ", sigma ratio " << s.sigma_ratio << ")\n";
   std::cout << "selection: " << x.selection.criterion_description << "\n";
   if (!x.selection.runner_up.model.empty())
     std::cout << "runner-up: " << x.selection.runner_up.model << ", criterion "
-              << x.selection.runner_up_delta << " worse than " << x.selection.chosen.model
-              << "\n";
+              << x.selection.runner_up_delta << " worse than " << x.selection.chosen.model << "\n";
   std::cout << "baseline residual signature: " << x.baseline_signature.describe(0.01) << "\n";
   std::cout << "selected: " << (x.selection.selected.empty() ? "none" : "");
   for (size_t i = 0; i < x.selection.selected.size(); ++i)
