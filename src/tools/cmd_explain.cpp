@@ -30,7 +30,7 @@ const char* kHelp =
     "usage: cvg_ident explain INPUT --mode free_decay|forced [--json FILE] [--report DIR]\n"
     "         [--omega W] [--confidence P] [--angular-gain K] [--mu M] [--alpha A]\n"
     "         [--candidates a,b,...] [--holdout-fraction F] [--columns t=COL,f=COL,g=COL]\n"
-    "         [--no-figures]\n"
+    "         [--no-figures] [--threads N]\n"
     "Fits the linear model, shows what it gets wrong (residual signature against amplitude^2,\n"
     "amplitude^4, time or detuning, pattern angle), tries the candidate extensions (free decay: "
     "xi,\n"
@@ -44,6 +44,8 @@ const char* kHelp =
     "(unless --no-figures) PNG figures + report.md by scripts/explain_report.py.\n"
     "INPUT: t,q1,p1,q2,p2 (free decay), omega0,q1,p1,q2,p2 (forced) or raw t,f,g (demodulated\n"
     "first at --omega or the file's omega); or a .bag of the project's messages (--topic NAME).\n"
+    "--threads N: candidate fits run N at a time (default 0 = the machine's cores; the results\n"
+    "do not depend on N).\n"
     "example: cvg_ident explain slow.csv --mode free_decay --json explain.json\n";
 
 std::vector<std::string> splitList(const std::string& s) {
@@ -98,16 +100,15 @@ void printSummary(const Explanation& x) {
   for (const auto& s : x.selection.steps)
     std::cout << "  + " << std::left << std::setw(9) << s.added << std::right << " sigma "
               << s.sigma << "  ratio " << s.sigma_ratio << "  F " << s.wald.f_statistic << "  p "
-              << s.wald.p_value << "  dIC " << s.delta_criterion << "  hold-out "
-              << s.holdout_ratio << "\n";
+              << s.wald.p_value << "  dIC " << s.delta_criterion << "  hold-out " << s.holdout_ratio
+              << "\n";
   for (const auto& s : x.selection.last_round)
     std::cout << "    (not accepted: +" << s.added << ", dIC " << s.delta_criterion << ", p "
               << s.wald.p_value << ", sigma ratio " << s.sigma_ratio << ")\n";
   std::cout << "selection: " << x.selection.criterion_description << "\n";
   if (!x.selection.runner_up.model.empty())
     std::cout << "runner-up: " << x.selection.runner_up.model << ", criterion "
-              << x.selection.runner_up_delta << " worse than " << x.selection.chosen.model
-              << "\n";
+              << x.selection.runner_up_delta << " worse than " << x.selection.chosen.model << "\n";
   std::cout << "baseline residual signature: " << x.baseline_signature.describe(0.01) << "\n";
   std::cout << "selected: " << (x.selection.selected.empty() ? "none" : "");
   for (size_t i = 0; i < x.selection.selected.size(); ++i)
@@ -122,7 +123,7 @@ void printSummary(const Explanation& x) {
 int runExplain(const std::vector<std::string>& argv) {
   const CliArgs args(argv,
                      {"mode", "json", "report", "omega", "confidence", "angular-gain", "mu",
-                      "alpha", "candidates", "holdout-fraction", "columns", "topic"},
+                      "alpha", "candidates", "holdout-fraction", "columns", "topic", "threads"},
                      {"no-figures"});
   if (args.help()) {
     std::cout << kHelp;
@@ -143,6 +144,9 @@ int runExplain(const std::vector<std::string>& argv) {
   options.fitting.holdout_fraction =
       args.getDouble("holdout-fraction", options.fitting.holdout_fraction);
   if (args.has("candidates")) options.candidates = splitList(args.get("candidates"));
+  const long threads = args.getInt("threads", 0);
+  if (threads < 0 || threads > 64) throw InputError("--threads must lie in 0..64");
+  options.selection.threads = static_cast<int>(threads);
 
   RecordReadOptions read;
   read.repair_raw_timestamps = true;

@@ -17,12 +17,14 @@
 #include <algorithm>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <map>
 #include <sstream>
 
 #include "cvg_bench/core/diagnose/forward_selection.h"
 #include "cvg_bench/core/diagnose/nested_model_fitters.h"
+#include "cvg_bench/core/diagnose/parallel_tasks.h"
 #include "cvg_bench/core/diagnose/residual_correlation.h"
 #include "cvg_bench/core/model/errors.h"
 
@@ -35,6 +37,7 @@ std::vector<std::string> SelectionOptions::validate() const {
     p.push_back("min_holdout_ratio must be finite and >= 0");
   if (max_steps < 1 || max_steps > 4) p.push_back("max_steps must lie in 1..4");
   if (finalists < 1 || finalists > 20) p.push_back("finalists must lie in 1..20");
+  if (threads < 0 || threads > 64) p.push_back("threads must lie in 0..64");
   return p;
 }
 
@@ -124,31 +127,102 @@ class SubsetSearch {
     const auto it = holdout_.find(k);
     if (it != holdout_.end()) return it->second;
     double h = kInf;
+    std::exception_ptr error;
     try {
       h = fitter_.holdoutRms(t);
-    } catch (const std::exception& err) {
-      if (notes_) notes_->push_back("hold-out of " + k + " failed: " + err.what());
+    } catch (...) {
+      error = std::current_exception();
     }
-    holdout_[k] = h;
-    return h;
+    return storeHoldout(k, h, error);
+  }
+
+  /// Refines every subset of `batch` not refined yet, several at a time (options.threads); the
+  /// cache and the notes end as if refined() had been called on each in batch order.
+  void refineAll(const std::vector<Terms>& batch) {
+    // Without an output-error stage refined() is the cheap fit, which extends a shared factor.
+    if (!fitter_.refinesByOutputError()) return;
+    std::vector<Terms> todo;
+    for (const auto& t : batch) {
+      const std::string k = key(t);
+      if (refined_.count(k) || failed_.count(k + "/r") || contains(todo, t)) continue;
+      todo.push_back(t);
+    }
+    std::vector<NestedFit> fits(todo.size());
+    std::vector<std::exception_ptr> errors(todo.size());
+    runTasks(todo.size(), options_.threads, [&](size_t i) {
+      try {
+        fits[i] = fitter_.fit(todo[i]);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    });
+    for (size_t i = 0; i < todo.size(); ++i)
+      store(key(todo[i]), &refined_, true, std::move(fits[i]), errors[i]);
+  }
+
+  /// The hold-outs of `batch` not computed yet, several at a time; as holdout() in batch order.
+  void holdoutAll(const std::vector<Terms>& batch) {
+    std::vector<Terms> todo;
+    for (const auto& t : batch)
+      if (!hasHoldout(t) && !contains(todo, t)) todo.push_back(t);
+    std::vector<double> h(todo.size(), kInf);
+    std::vector<std::exception_ptr> errors(todo.size());
+    runTasks(todo.size(), options_.threads, [&](size_t i) {
+      try {
+        h[i] = fitter_.holdoutRms(todo[i]);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    });
+    for (size_t i = 0; i < todo.size(); ++i) storeHoldout(key(todo[i]), h[i], errors[i]);
   }
 
  private:
+  static bool contains(const std::vector<Terms>& list, const Terms& t) {
+    return std::find(list.begin(), list.end(), t) != list.end();
+  }
+
   const NestedFit* cached(const Terms& t, std::map<std::string, NestedFit>* cache, bool refine) {
     const std::string k = key(t);
     const auto it = cache->find(k);
     if (it != cache->end()) return &it->second;
     if (failed_.count(k + (refine ? "/r" : "/c"))) return nullptr;
+    NestedFit f;
+    std::exception_ptr error;
     try {
-      NestedFit f = refine ? fitter_.fit(t) : fitter_.fitEquationError(t);
-      return &cache->emplace(k, std::move(f)).first->second;
+      f = refine ? fitter_.fit(t) : fitter_.fitEquationError(t);
+    } catch (...) {
+      error = std::current_exception();
+    }
+    return store(k, cache, refine, std::move(f), error);
+  }
+
+  /// Keeps a finished fit, or notes why it failed (errors other than std::exception propagate).
+  const NestedFit* store(const std::string& k, std::map<std::string, NestedFit>* cache, bool refine,
+                         NestedFit f, const std::exception_ptr& error) {
+    if (!error) return &cache->emplace(k, std::move(f)).first->second;
+    try {
+      std::rethrow_exception(error);
     } catch (const std::exception& err) {
       failed_[k + (refine ? "/r" : "/c")] = true;
       if (notes_)
         notes_->push_back("subset " + k + " skipped (" + (refine ? "refined" : "LS") +
                           " fit failed): " + err.what());
-      return nullptr;
     }
+    return nullptr;
+  }
+
+  double storeHoldout(const std::string& k, double h, const std::exception_ptr& error) {
+    if (error) {
+      try {
+        std::rethrow_exception(error);
+      } catch (const std::exception& err) {
+        if (notes_) notes_->push_back("hold-out of " + k + " failed: " + err.what());
+      }
+      h = kInf;
+    }
+    holdout_[k] = h;
+    return h;
   }
 
   const NestedModelFitter& fitter_;
@@ -228,6 +302,7 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
   for (const auto& s : scores)
     if (!s.terms.empty() && static_cast<int>(finalists.size()) <= options.finalists)
       finalists.push_back(s.terms);
+  search.refineAll(finalists);  // the linear model first: the order refined() would be called in
   const NestedFit* base = search.refined({});
   const bool refined_scale =
       fitter.refinesByOutputError() && base != nullptr && base->estimate.method == "ceres";
@@ -290,14 +365,18 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     const Terms best = r.front().second;
     const double best_v = r.front().first;
     bool improved = false;
+    std::vector<Terms> extensions;
     for (const auto& name : search.names()) {
       if (std::find(best.begin(), best.end(), name) != best.end()) continue;
       Terms t = best;
       t.push_back(name);
       t = search.canonical(t);
       if (static_cast<int>(t.size()) > options.max_steps || crit.count(key(t))) continue;
-      if (score(t) < best_v) improved = true;
+      extensions.push_back(t);
     }
+    search.refineAll(extensions);
+    for (const auto& t : extensions)
+      if (score(t) < best_v) improved = true;
     if (!improved) break;
   }
   const double base_crit = score({});
@@ -327,6 +406,9 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     while (shrunk && !best.empty()) {
       shrunk = false;
       Terms better = best;
+      std::vector<Terms> smaller_subsets;
+      for (const auto& name : best) smaller_subsets.push_back(without(best, name));
+      search.refineAll(smaller_subsets);
       for (const auto& name : best) {
         const Terms smaller = without(best, name);
         if (score(smaller) < score(better)) better = smaller;
@@ -344,6 +426,7 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     if (best.empty()) break;
     if (best != top && rejected(best)) continue;
     if (best != top) rejected_keys.push_back(key(best));
+    search.holdoutAll({{}, best});
     const double h = ratio(search.holdout({}), search.holdout(best));
     if (h > options.min_holdout_ratio) {
       chosen = best;
@@ -372,6 +455,14 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
   while (prefix.size() < chosen.size()) {
     std::string add;
     double best_v = kInf;
+    std::vector<Terms> next_subsets;
+    for (const auto& n : chosen) {
+      if (std::find(prefix.begin(), prefix.end(), n) != prefix.end()) continue;
+      Terms t = prefix;
+      t.push_back(n);
+      next_subsets.push_back(search.canonical(t));
+    }
+    search.refineAll(next_subsets);
     for (const auto& n : chosen) {
       if (std::find(prefix.begin(), prefix.end(), n) != prefix.end()) continue;
       Terms t = prefix;
@@ -392,6 +483,7 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     s.wald = waldTest(f->estimate, {add});
     s.delta_bic =
         deltaBic(prev->rss, f->rss, f->n_equations, f->estimate.n_params - prev->estimate.n_params);
+    search.holdoutAll({search.canonical(prefix), search.canonical(next)});
     s.holdout_ratio =
         ratio(search.holdout(search.canonical(prefix)), search.holdout(search.canonical(next)));
     s.delta_criterion = best_v - score(search.canonical(prefix));

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <mutex>
 #include <sstream>
 
 #include "cvg_bench/core/demod/demodulator_noise.h"
@@ -434,9 +435,18 @@ void fillIntervals(const FittedProblem& fp, const AtSolution& a, const RankAnaly
   e->rank_tolerance = options.rank_tolerance;
 }
 
+/// The dense Jacobian at the solution holds 4N x p doubles (the solve itself holds nothing of
+/// size N): refinements running concurrently (explain's batches of candidate fits) take turns
+/// here, so that the peak memory stays that of one; the results do not depend on the order.
+std::mutex& denseJacobianTurn() {
+  static std::mutex turn;
+  return turn;
+}
+
 /// Rank, covariance (outputErrorCovariance), intervals (fillIntervals), identifiability and
 /// derived quantities of the fitted problem.
 void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estimate* e) {
+  const std::lock_guard<std::mutex> turn(denseJacobianTurn());
   const AtSolution a = evaluateAtSolution(fp);
   const int n = static_cast<int>(a.j.rows());
   const RankAnalysis r = numericalRank(a.j, options.rank_tolerance);

@@ -83,6 +83,9 @@ struct SelectionOptions {
   int finalists = 4;
   /// Drop a term of the chosen subset when the subset without it has a better refined criterion.
   bool backward_check = true;
+  /// Refined fits and hold-outs of one selection step run this many at a time, 0..64 (0: the
+  /// machine's cores); the selection and every number are the same for any value.
+  int threads = 0;
 
   /// Every problem with the options, empty when valid.
   std::vector<std::string> validate() const;

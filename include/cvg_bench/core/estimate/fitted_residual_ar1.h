@@ -9,7 +9,10 @@
 // L the symmetrised one-step shift, A = sym(J' Sigma L J), B = J' L J. The fit removes mostly
 // slow (low-frequency) noise, so the residuals' lag-1 correlation r'Lr / r'r falls below rho
 // (AR(1) rho = 0.9 on ~10^3 samples with ~10 unknowns: ~0.87, i.e. ~15 % too narrow intervals).
-// rho is the root of E[r'Lr] / E[r'r] = the observed lag-1 correlation (bisection).
+// rho is the root of E[r'Lr] / E[r'r] = the observed lag-1 correlation (bisection). The lag sums
+// enter only as M_0, M_1 and sum_d rho^d M_d, M_d = sum_i J_{i+cd}' J_i: formed lag by lag on
+// small problems (rows x lags <= 2e7), else by one backward recursion over J per rho (O(n p^2)
+// whatever the number of lags; the same sums up to rounding).
 #pragma once
 
 #include <Eigen/Core>
@@ -21,7 +24,8 @@ namespace cvg_bench {
 double fittedResidualAr1(const Eigen::MatrixXd& j, const Eigen::MatrixXd& c, int channels,
                          double observed_lag1);
 
-/// The same expectation for a given rho (exposed for tests): E[r'Lr] / E[r'r].
+/// The same expectation for a given rho, always by the recursion (exposed for tests):
+/// E[r'Lr] / E[r'r].
 double expectedResidualLag1(const Eigen::MatrixXd& j, const Eigen::MatrixXd& c, int channels,
                             double rho);
 
