@@ -123,9 +123,10 @@ def make_trajectory(args):
 
 def noisy_record(case, work):
     """Writes the measured record of a case; returns (csv path, truth z, omega)."""
-    base, p, z = truth(case["kind"], case["preset"], case["hidden"])
-    d = np.load(os.path.join(work, "traj_" + traj_key(case["kind"], case["preset"],
-                                                      case["hidden"]) + ".npz"))
+    # "gen" = what the generator hid (an outside effect included); "hidden" is what is scored
+    gen = case.get("gen", case["hidden"])
+    base, p, z = truth(case["kind"], case["preset"], gen)
+    d = np.load(os.path.join(work, "traj_" + traj_key(case["kind"], case["preset"], gen) + ".npz"))
     rng = np.random.default_rng(case["seed"])
     path = os.path.join(work, "rec_%s_%d_%s.csv" % (case["kind"], case["id"],
                                                      case.get("method", "explain")))
@@ -544,6 +545,9 @@ def main():
     ap.add_argument("--coverage-runs", type=int, default=60)
     ap.add_argument("--thin", type=int, default=1,
                     help="explain: keep clean records and 1/THIN of the others (seed-chosen)")
+    ap.add_argument("--labels", default="",
+                    help="only these hidden labels (comma-separated; 'outside' = every effect "
+                    "outside the library); for studies, not for the doc tables")
     ap.add_argument("--json", default="", help="all results as JSON")
     ap.add_argument("--markdown", default="", help="write the full report (tables) here")
     ap.add_argument("--work", default="", help="cache the clean trajectories in this folder")
@@ -621,6 +625,10 @@ def run_all(args, kinds):
     if args.thin > 1:  # keep the clean records, and a seed-chosen 1/thin of the others
         cases = [c for c in cases if c["kind"].startswith("cov_") or c["label"] == "none"
                  or c["seed"] % args.thin == 0]
+    if args.labels:  # a subset by what was hidden (e.g. the effects outside the library)
+        want = set(args.labels.split(","))
+        cases = [c for c in cases if c["label"] in want
+                 or ("outside" in want and c.get("outside"))]
     if args.quick:  # the smoke subset: explain cases, plus at most 1 coverage pair
         cov = [c for c in cases if c["kind"].startswith("cov_")][:2]
         cases = [c for c in cases if not c["kind"].startswith("cov_")] + cov
@@ -701,6 +709,9 @@ def report(args, kinds, terms, results, t_start):
     head = report_header(args, elapsed, len(results))
     if getattr(args, "seed_base", SEED0) != SEED0:
         print("note: tuning seeds (--seed-base %d): no doc section written" % args.seed_base)
+        return
+    if getattr(args, "labels", ""):
+        print("note: a subset (--labels): no doc section written")
         return
     explain_kinds = [k for k in KINDS if not k.startswith("cov_")]
     if args.explain_doc and sx:
