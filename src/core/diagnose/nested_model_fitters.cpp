@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "cvg_bench/core/demod/demodulator_noise.h"
+#include "cvg_bench/core/diagnose/candidate_extensions.h"
 #include "cvg_bench/core/diagnose/sweep_noise_model.h"
 #include "cvg_bench/core/estimate/free_decay_regression.h"
 #include "cvg_bench/core/estimate/identify_pipeline.h"
@@ -350,6 +351,7 @@ class ForcedFitter : public NestedModelFitter {
     if (!(omega_ > 0.0))
       throw InputError("forced sweep" + (record.source.empty() ? "" : " " + record.source) +
                        ": natural frequency omega unknown (give --omega or '# omega:')");
+    rho_ = noiseRhoAlongSweep();
   }
 
   NestedFit fit(const std::vector<std::string>& extensions) const override {
@@ -361,7 +363,7 @@ class ForcedFitter : public NestedModelFitter {
     long count = 0;
     for (int fold = 0; fold < 2; ++fold) {
       const SweepRecord train = subset(fold), test = subset(1 - fold);
-      const NestedFit f = fitOn(train, extensions);
+      const NestedFit f = fitEquationsOn(train, extensions);
       IdentificationOptions o = optionsFor(extensions, f);
       const StackedSystem sys = buildForcedSystem({test}, o);
       ss += equationResiduals(sys, linearPart(f)).squaredNorm();
@@ -450,7 +452,74 @@ class ForcedFitter : public NestedModelFitter {
     return z.head(k);
   }
 
+  /// The residual sum that ranks subsets, in output-error units: the feasible GLS of (3.4) with
+  /// the block of point j weighted by W_j = A_j^-1 (A_j = dF/dq at the current fit), i.e.
+  /// min_z sum_j |A_j^-1 F_j(z)|^2, the linearized output error of adequacyResiduals; two passes.
+  /// The equation residuals' scale grows with the detuning, so their plain sum is ruled by the
+  /// wings while the effects live near resonance; under white noise on q the weighted sum is
+  /// the likelihood's. Singular values of A_j are floored at 1e-2 of the largest (folds).
+  /// sigma, residuals and the estimate stay those of the equation-error fit.
+  void scoreInOutputErrorUnits(const SweepRecord& record, const IdentificationOptions& o,
+                               NestedFit* f) const {
+    const StackedSystem sys = buildForcedSystem({record}, o);
+    const ResonatorModel model(o.model, ExperimentMode::kForced);
+    const SlowContext ctx{0.0, o.mu};
+    Eigen::VectorXd z = linearPart(*f);
+    Eigen::MatrixXd dw(sys.d.rows(), sys.d.cols());
+    Eigen::VectorXd yw(sys.y.size());
+    const auto weigh = [&]() {
+      for (size_t j = 0; j < record.size(); ++j) {
+        const double rate = detuningRate(omega_, record.omega0_rad_s[j]);
+        const Eigen::Matrix4d a = stationaryJacobian(model, record.q[j], ctx, z, rate);
+        const Eigen::JacobiSVD<Eigen::Matrix4d> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
+        const Eigen::Vector4d sv = svd.singularValues().cwiseMax(1e-2 * svd.singularValues()(0));
+        const Eigen::Matrix4d w =
+            svd.matrixV() * sv.cwiseInverse().asDiagonal() * svd.matrixU().transpose();
+        const long i = 4 * static_cast<long>(j);
+        dw.middleRows(i, 4) = w * sys.d.middleRows(i, 4);
+        yw.segment<4>(i) = w * sys.y.segment<4>(i);
+      }
+    };
+    // AR(1) along the sweep (rho_): whiten the weighted rows, x_j - rho x_{j-1} (Prais-Winsten).
+    const auto whiten = [&]() {
+      if (!(rho_ > 0.0)) return;
+      for (long j = static_cast<long>(record.size()) - 1; j >= 1; --j) {
+        dw.middleRows(4 * j, 4) -= rho_ * dw.middleRows(4 * (j - 1), 4);
+        yw.segment<4>(4 * j) -= rho_ * yw.segment<4>(4 * (j - 1));
+      }
+      dw.topRows(4) *= std::sqrt(1.0 - rho_ * rho_);
+      yw.head<4>() *= std::sqrt(1.0 - rho_ * rho_);
+    };
+    for (int pass = 0; pass < 2; ++pass) {
+      weigh();
+      whiten();
+      if (!dw.allFinite() || !yw.allFinite()) return;  // keep the equation-error sum
+      const Eigen::VectorXd norms = dw.colwise().norm().transpose().cwiseMax(1e-300);
+      const Eigen::MatrixXd scaled = dw * norms.cwiseInverse().asDiagonal();
+      const Eigen::VectorXd next = scaled.colPivHouseholderQr().solve(yw).cwiseQuotient(norms);
+      if (!next.allFinite()) return;
+      z = next;
+    }
+    weigh();
+    whiten();
+    const Eigen::VectorXd r = yw - dw * z;
+    const double rss = r.squaredNorm();
+    if (std::isfinite(rss) && rss > 0.0) {
+      f->rss = rss;
+      f->n_equations = static_cast<long>(yw.size());
+      f->scored_residuals = r;
+    }
+  }
+
   NestedFit fitOn(const SweepRecord& record, const std::vector<std::string>& extensions) const {
+    NestedFit f = fitEquationsOn(record, extensions);
+    IdentificationOptions o = optionsFor(extensions, f);
+    scoreInOutputErrorUnits(record, o, &f);
+    return f;
+  }
+
+  NestedFit fitEquationsOn(const SweepRecord& record,
+                           const std::vector<std::string>& extensions) const {
     const ResonatorModel model(extensions, ExperimentMode::kForced);
     IdentificationOptions o = options_.identification;
     o.omega_rad_s = omega_;
@@ -483,9 +552,26 @@ class ForcedFitter : public NestedModelFitter {
     return s;
   }
 
+  /// rho of the AR(1) along the sweep (sweep_noise_ar1.h) from the linearized output errors of
+  /// the whole library's fit (least misfit; the linear model's if that fit fails): one noise
+  /// model for every subset, so their criteria are comparable.
+  double noiseRhoAlongSweep() const {
+    std::vector<std::string> library;
+    for (const auto& c : candidateExtensions(ExperimentMode::kForced)) library.push_back(c.name);
+    for (const auto& ext : {library, std::vector<std::string>{}}) {
+      try {
+        return noiseModelAlongSweep(linearize(fitEquationsOn(record_, ext)).blocks).rho1;
+      } catch (const std::exception&) {
+        continue;  // the selection reports a failing fit itself
+      }
+    }
+    return 0.0;
+  }
+
   SweepRecord record_;
   NestedFitterOptions options_;
   double omega_ = 0.0;
+  double rho_ = 0.0;
 };
 
 }  // namespace

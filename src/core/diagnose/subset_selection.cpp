@@ -279,7 +279,8 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
         widest = f;
     }
   }
-  result.correlation_factor_ls = longRunVarianceFactor(widest->residuals, 4);
+  result.correlation_factor_ls = longRunVarianceFactor(
+      widest->scored_residuals.size() ? widest->scored_residuals : widest->residuals, 4);
   const double c_ls = result.correlation_factor_ls;
   std::vector<SubsetScore> scores;
   for (const auto& t : all) {

@@ -2,6 +2,12 @@
 
 namespace cvg_bench {
 
+SweepNoiseOptions adequacySweepNoiseOptions() {
+  SweepNoiseOptions o;
+  o.upper_standard_errors = 1.0;
+  return o;
+}
+
 ResidualNoiseModel noiseModelAlongSweep(const std::vector<BlockResidual>& blocks,
                                         const SweepNoiseOptions& options) {
   std::vector<Eigen::Vector4d> r;

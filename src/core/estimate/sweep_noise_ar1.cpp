@@ -9,6 +9,13 @@
 #include "cvg_bench/core/estimate/fitted_residual_ar1.h"
 
 namespace cvg_bench {
+namespace {
+std::string num(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+}  // namespace
 
 SweepAr1 sweepNoiseAr1(const std::vector<Eigen::Vector4d>& r, const std::vector<double>& amp2,
                        const std::vector<double>& abscissa, const SweepNoiseOptions& options) {
@@ -56,6 +63,8 @@ SweepAr1 sweepNoiseAr1(const std::vector<Eigen::Vector4d>& r, const std::vector<
   const Eigen::MatrixXd gram_inv =
       (basis.transpose() * basis).completeOrthogonalDecomposition().pseudoInverse();
   rho = std::max(0.0, fittedResidualAr1(basis, gram_inv, 1, rho));
+  if (rho >= 0.05 && options.upper_standard_errors > 0.0)
+    rho += options.upper_standard_errors * std::sqrt((1.0 - std::min(rho * rho, 1.0)) / n);
   out.capped = rho > options.ceiling;
   rho = std::min(rho, options.ceiling);
   if (rho < 0.05) {
@@ -64,8 +73,10 @@ SweepAr1 sweepNoiseAr1(const std::vector<Eigen::Vector4d>& r, const std::vector<
     return out;
   }
   out.rho = rho;
-  d << "AR(1) along the sweep, rho " << rho << (out.capped ? " (capped)" : "") << ", from the " << n
-    << " quiet points (amplitude^2 <= " << options.quiet_fraction
+  d << "AR(1) along the sweep, rho " << rho << (out.capped ? " (capped)" : "")
+    << (options.upper_standard_errors > 0.0 ? " (estimate + " : "")
+    << (options.upper_standard_errors > 0.0 ? num(options.upper_standard_errors) + " SE)" : "")
+    << ", from the " << n << " quiet points (amplitude^2 <= " << options.quiet_fraction
     << " x the largest) of the output-error residuals after Legendre P_0..P_" << k - 1
     << " in the drive frequency";
   out.description = d.str();

@@ -50,6 +50,10 @@ TEST(SweepNoiseModel, OutputErrorResidualsAreTheNoiseAtEveryPoint) {
   // The equation residuals do not have that property (their scale follows the detuning).
   const double ratio_e = std::sqrt(se_far / n_far) / std::sqrt(se_near / n_near);
   EXPECT_GT(ratio_e, 1.5);
+  // The sum that ranks subsets is the output errors' (GLS in those units): RMS = the noise std.
+  const long n = fit.n_equations;
+  EXPECT_EQ(fit.scored_residuals.size(), 4 * static_cast<long>(rec.sweep.size()));
+  EXPECT_NEAR(std::sqrt(fit.rss / n), sigma, sigma * (3.0 / std::sqrt(2.0 * n) + 0.05));
 }
 
 std::vector<BlockResidual> ar1Blocks(double rho, int n, uint64_t seed, int bump_from, int bump_to,
@@ -80,6 +84,18 @@ TEST(SweepNoiseModel, Ar1FromTheQuietPointsIgnoresAMisfitAtResonance) {
   const ResidualNoiseModel m_all = noiseModelAlongSweep(b, all);
   ASSERT_EQ(m_all.ar.size(), 1u);
   EXPECT_GT(m_all.ar[0], 0.85);
+}
+
+// explain's tests whiten with rho + 1 SE, SE = sqrt((1 - rho^2) / n_quiet); the intervals use rho.
+TEST(SweepNoiseModel, ExplainRaisesRhoByOneStandardError) {
+  const auto b = ar1Blocks(0.7, 400, 8102, 190, 215, 8.0);  // 375 quiet points
+  const ResidualNoiseModel plain = noiseModelAlongSweep(b, SweepNoiseOptions());
+  const ResidualNoiseModel tests = noiseModelAlongSweep(b);
+  ASSERT_EQ(plain.ar.size(), 1u);
+  ASSERT_EQ(tests.ar.size(), 1u);
+  const double r = plain.ar[0];
+  EXPECT_NEAR(tests.ar[0] - r, std::sqrt((1.0 - r * r) / 375.0), 1e-12);
+  EXPECT_NE(tests.description.find("+ 1 SE"), std::string::npos) << tests.description;
 }
 
 TEST(SweepNoiseModel, WhiteNoiseAndTooFewPointsGiveWhite) {
@@ -116,9 +132,10 @@ SweepRecord sweepWithAr1Noise(double xi, double rho, uint64_t seed) {
 TEST(SweepNoiseModel, CleanSweepWithNoiseCorrelatedAlongItIsAdequate) {
   for (uint64_t seed : {8111u, 8112u, 8113u}) {
     const Explanation x = explainForced(sweepWithAr1Noise(0.0, 0.9, seed), ExplainOptions());
-    // Adequacy only: the selection's criterion can still take a null term under noise this slow
-    // (2 of these 3 seeds select gamma_nl; docs/validation_independent.md has the rates).
+    // Subsets are scored by the whitened output errors (nested_model_fitters.h); before that, 2 of
+    // these 3 seeds selected a null gamma_nl.
     EXPECT_FALSE(x.unexplained) << "seed " << seed << ": " << x.cause;
+    EXPECT_TRUE(x.selection.selected.empty()) << "seed " << seed << ": " << x.cause;
     EXPECT_NE(x.noise_model.description.find("AR(1) along the sweep"), std::string::npos)
         << x.noise_model.description;
   }

@@ -37,6 +37,9 @@ struct NestedFit {
   double rss = 0.0;                     ///< residual sum of squares of the equations
   long n_equations = 0;
   Eigen::VectorXd residuals;  ///< equation residuals y - D z (4 per block)
+  /// The residuals behind rss when they are not `residuals` (forced sweeps: whitened output
+  /// errors, nested_model_fitters.h); the selection's c is computed from these.
+  Eigen::VectorXd scored_residuals;
 };
 
 /// Mode-specific fitting through the identification API (nested_model_fitters.h).

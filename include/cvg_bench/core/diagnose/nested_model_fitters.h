@@ -12,6 +12,10 @@
 // Forced: fit = buildForcedSystem + estimateFromSystem (per-point cluster sandwich); with `mu` in
 //   the extensions, mu comes from the output-error fit (refineWithCeres) and z is then refitted by
 //   LS at that mu, so sigma stays in equation units; the Wald test of mu uses the Ceres covariance.
+//   The residual sum that ranks subsets (NestedFit::rss, scored_residuals) is in output-error
+//   units: GLS of (3.4) with block j weighted by A_j^-1 (A_j = dF/dq, two passes) and whitened by
+//   one AR(1) along the sweep for all subsets (rho from the whole library's fit,
+//   sweep_noise_model.h), so the criterion is the likelihood under that noise model.
 //   hold-out = two-fold interleaved (even / odd sweep points): fit one half, equation residuals of
 //   the other, RMS over both folds [equation units].
 #pragma once

@@ -12,8 +12,14 @@
 
 namespace cvg_bench {
 
+/// The estimate as explain's tests use it: rho + 1 standard error (sweep_noise_ar1.h). On the
+/// tuning seeds the plain estimate (read low on 41-81 point sweeps) called 3 of 8 clean sweeps
+/// with AR(1) 0.9 along them "unexplained" (docs/explain_selection.md).
+SweepNoiseOptions adequacySweepNoiseOptions();
+
 /// AR(1) noise model of a sweep's output-error residual blocks (in measurement order).
-ResidualNoiseModel noiseModelAlongSweep(const std::vector<BlockResidual>& blocks,
-                                        const SweepNoiseOptions& options = {});
+ResidualNoiseModel noiseModelAlongSweep(
+    const std::vector<BlockResidual>& blocks,
+    const SweepNoiseOptions& options = adequacySweepNoiseOptions());
 
 }  // namespace cvg_bench

@@ -26,6 +26,10 @@ struct SweepNoiseOptions {
   double ceiling = 0.95;         ///< cap of rho, in (0, 1)
   int min_pairs = 8;             ///< fewer quiet pairs: white
   int degree = 3;                ///< K of the smooth part removed before the lag-1 estimate
+  /// rho raised by this many standard errors sqrt((1 - rho^2) / n_quiet) before the cap, >= 0.
+  /// The bounded estimate reads rho low on short sweeps; tests that whiten with it (explain) use
+  /// 1 to hold their level, the intervals 0 (their coverage is measured with it).
+  double upper_standard_errors = 0.0;
 };
 
 struct SweepAr1 {
