@@ -591,7 +591,9 @@ def load_runs(args):
         elapsed += d["elapsed_s"]
         kinds += [k for k in d["kinds"] if k not in kinds]
         terms = d.get("library_terms_beyond_ten", []) if terms is None else terms
-        args.tool_commit = d.get("tool", "?")
+        tools = [t for t in getattr(args, "tool_commit", "").split(", ") if t]
+        args.tool_commit = ", ".join(tools + [d.get("tool", "?")] * (d.get("tool", "?") not in tools))
+        args.thin = max(args.thin, d.get("thin", 1))
         args.parts = getattr(args, "parts", []) + ["%s (tool %s)" % (",".join(d["kinds"]),
                                                                       d.get("tool", "?"))]
         gen += d.get("gen_cpu_s", 0.0)
@@ -697,7 +699,7 @@ def report(args, kinds, terms, results, t_start):
         elapsed, len(results), args.cpu_total, args.cpu_total / 60.0 / args.jobs, args.jobs))
     if args.json:
         with open(args.json, "w") as fh:
-            json.dump(dict(results=results, elapsed_s=elapsed, quick=args.quick,
+            json.dump(dict(results=results, elapsed_s=elapsed, quick=args.quick, thin=args.thin,
                            selfcheck="ok", kinds=kinds, library_terms_beyond_ten=terms,
                            gen_cpu_s=args.gen_cpu, seed_base=getattr(args, "seed_base", SEED0),
                            tool=tool_version(args.tool),
@@ -803,6 +805,15 @@ Ceres coverage runs of one repeat share a record. Tuning discipline: every thres
 of the tool's adequacy test and selection was made on runs with `--seed-base 2000000` (seeds
 2000000 + CRC mod 10^6, disjoint from these); the tables here are the reporting seeds only, run
 after those choices were fixed.
+
+**Harness bug, fixed 2026-11-26**: until then a record with an effect outside the library was
+written from the *clean* trajectory (the generator made the right one; the record writer looked it
+up by the scored hidden set, without the outside effect). Every "outside the library" row before
+that date scored clean records, and a "before" of the before/after tables on those rows is a clean
+record. **A look-alike by design**: cm_step's time constant (record / 4) lies within a factor 2 of
+1 / (2 gamma) on every free-decay preset, so its frequency transient has the time course of an
+amplitude^2 law; explain fits it as xi + xi_k (a frequency law without precession) and now says
+that one decay cannot tell the two apart. Scored wrong here, as fixed before the run.
 """
 
 

@@ -115,6 +115,29 @@ std::string describeStep(const SelectionStep& s, const CandidateExtension& c, co
   return o.str();
 }
 
+/// A free decay ties amplitude to time (A^2 ~ exp(-2 gamma t)): an amplitude law selected from one
+/// record has a look-alike, a drift in time with the same course (the independent harness's
+/// saturating frequency transient with tau ~ 1/(2 gamma) was fitted as xi + xi_k, i.e. a frequency
+/// law without precession). Said with the time constant; empty otherwise.
+std::string amplitudeTimeCaveat(const Explanation& x, ExperimentMode mode) {
+  if (mode != ExperimentMode::kFreeDecay) return "";
+  std::vector<std::string> laws;
+  for (const auto& t : x.selection.selected)
+    if (t == "xi" || t == "kappa" || t == "gamma_nl" || t == "xi_diff" || t == "xi_k")
+      laws.push_back(t);
+  const auto g = x.finalEstimate().parameters.find("gamma");
+  if (laws.empty() || g == x.finalEstimate().parameters.end() || !(g->second.value > 0.0))
+    return "";
+  std::ostringstream o;
+  o << " One free decay ties amplitude to time (A^2 ~ exp(-2 gamma t), time constant "
+    << num(0.5 / g->second.value, 3) << " s): the amplitude law";
+  o << (laws.size() > 1 ? "s (" : " (");
+  for (size_t i = 0; i < laws.size(); ++i) o << (i ? ", " : "") << laws[i];
+  o << ") cannot be told with certainty from a drift in time with that course (e.g. a thermal "
+       "transient); a second decay from another initial amplitude separates them.";
+  return o.str();
+}
+
 std::string verdict(const Explanation& x, ExperimentMode mode, const ExplainOptions& options) {
   std::ostringstream o;
   const SelectionResult& sel = x.selection;
@@ -133,6 +156,7 @@ std::string verdict(const Explanation& x, ExperimentMode mode, const ExplainOpti
   if (!sel.runner_up.model.empty() && std::isfinite(sel.runner_up_delta))
     o << " Runner-up: " << sel.runner_up.model << ", criterion " << num(sel.runner_up_delta, 3)
       << (sel.runner_up_delta >= 0 ? " worse" : " better but not confirmed by the hold-out") << ".";
+  o << amplitudeTimeCaveat(x, mode);
   if (x.unexplained) {
     const LackOfFit& l = x.lack_of_fit;
     const bool slow = l.low_frequency_p_value < l.runs_p_value;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <random>
+#include <sstream>
 
 #include "cvg_bench/core/diagnose/explanation.h"
 #include "cvg_bench/core/model/resonator_preset.h"
@@ -78,6 +79,13 @@ TEST(HiddenEffect, FreeDecayFindsTheDrawnEffect) {
   EXPECT_EQ(x.selection.selected, std::vector<std::string>{e.name}) << x.cause;
   const auto& p = x.finalEstimate().parameters.at(e.name);
   EXPECT_NEAR(p.value, e.value, 4 * p.std_error) << x.cause;
+  // An amplitude law from one decay carries its look-alike in time, with 1 / (2 gamma).
+  const double gamma = x.finalEstimate().parameters.at("gamma").value;
+  std::ostringstream tau;
+  tau.precision(3);
+  tau << "time constant " << 0.5 / gamma << " s";
+  EXPECT_NE(x.cause.find("ties amplitude to time"), std::string::npos) << x.cause;
+  EXPECT_NE(x.cause.find(tau.str()), std::string::npos) << x.cause << " / " << tau.str();
 }
 
 // Frequency drift during the record: identify (LS) finds cm_rate = 217 +/- 19 at truth 200 on
@@ -89,6 +97,7 @@ TEST(HiddenEffect, FreeDecayFindsFrequencyDrift) {
   EXPECT_EQ(x.selection.selected, std::vector<std::string>{e.name}) << x.cause;
   const auto& p = x.finalEstimate().parameters.at(e.name);
   EXPECT_NEAR(p.value, e.value, 4 * p.std_error) << x.cause;
+  EXPECT_EQ(x.cause.find("ties amplitude to time"), std::string::npos) << x.cause;  // a time law
 }
 
 TEST(HiddenEffect, CleanDataSelectsNothing) {
