@@ -38,6 +38,29 @@ class GeneratorKnownAnswers(unittest.TestCase):
                 self.assertLessEqual(err, tol, name)
 
 
+class OutsideEffectRecords(unittest.TestCase):
+    """A record with an effect outside the library is written from the trajectory that has it
+    (until 2026-11-26 the writer looked up the clean one): same seed, the records differ by >5
+    noise std (identical under the bug)."""
+
+    def test_outside_effect_reaches_the_record(self):
+        import numpy as np
+        import validate_independent as vi
+        with tempfile.TemporaryDirectory() as work:
+            paths = []
+            for i, gen in enumerate([[], ["delay"]]):
+                case = dict(kind="sweep", preset="sw_ring_24k", noise="white", hidden=[],
+                            gen=gen, outside=gen[0] if gen else None, id=i, seed=4242)
+                _, _, err = vi.make_trajectory(("sweep", "sw_ring_24k", gen, work))
+                self.assertEqual(err, "")
+                paths.append(vi.noisy_record(case, work)[0])
+            clean, delayed = (np.genfromtxt(p, delimiter=",", comments="#", skip_header=3)
+                              for p in paths)
+        sigma = vi.presets.SWEEP["sw_ring_24k"]["sigma"]
+        self.assertEqual(clean.shape, delayed.shape)
+        self.assertGreater(np.abs(clean[:, 1:] - delayed[:, 1:]).max(), 5 * sigma)  # 7.4 sigma
+
+
 @unittest.skipUnless(tool_works(), "cvg_ident not built")
 class QuickRun(unittest.TestCase):
     def test_quick_subset_runs_and_scores(self):
