@@ -220,7 +220,11 @@ Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
     // whole sweep it absorbed a missing cubic stiffness.
     x.noise_model = noiseModelAlongSweep(adequacy);
   } else if (!known.empty()) {
-    x.noise_model = noiseModelFromCorrelation(known);
+    // The known part, then an AR(1) of what it leaves (noise coloured before the demodulator,
+    // a drifting pick-off gain), as the low-frequency test does.
+    Eigen::VectorXd e(4 * adequacy.size());
+    for (size_t i = 0; i < adequacy.size(); ++i) e.segment<4>(4 * i) = adequacy[i].e;
+    x.noise_model = withDetrendedAr1(noiseModelFromCorrelation(known), e, 4);
   } else {
     Eigen::VectorXd e(4 * adequacy.size());
     for (size_t i = 0; i < adequacy.size(); ++i) e.segment<4>(4 * i) = adequacy[i].e;

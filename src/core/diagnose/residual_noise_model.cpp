@@ -151,4 +151,25 @@ Eigen::VectorXd whiten(const Eigen::VectorXd& residuals, int channels,
   return w;
 }
 
+ResidualNoiseModel withDetrendedAr1(const ResidualNoiseModel& known,
+                                    const Eigen::VectorXd& residuals, int channels) {
+  const long per_channel = channels > 0 ? residuals.size() / channels : 0;
+  if (per_channel < 16) return known;
+  const long skip = channels * std::min<long>(static_cast<long>(known.ar.size()), per_channel / 2);
+  const Eigen::VectorXd w = whiten(residuals, channels, known).tail(residuals.size() - skip);
+  const ResidualNoiseModel extra = noiseModelFromDetrendedResiduals(w, channels);
+  if (extra.ar.empty()) return known;
+  const double b = extra.ar[0];
+  ResidualNoiseModel m = known;
+  m.ar.assign(known.ar.size() + 1, 0.0);
+  for (size_t j = 0; j < m.ar.size(); ++j) {
+    const double a_j = j < known.ar.size() ? known.ar[j] : 0.0;
+    const double a_before = j == 0 ? -1.0 : known.ar[j - 1];
+    m.ar[j] = a_j - b * a_before;
+  }
+  m.description = (known.ar.empty() ? std::string("white") : known.description) + "; then " +
+                  extra.description + " of what it leaves";
+  return m;
+}
+
 }  // namespace cvg_bench

@@ -148,5 +148,38 @@ TEST(ResidualNoiseModel, LevinsonRecoversAr2AndWhitens) {
   EXPECT_NEAR(w[4], 3.0 - 0.5 * -1.0 - 0.3 * 0.0, 1e-12);
 }
 
+// Noise coloured beyond the known part: (1 - 0.4 L)(1 - 0.6 L) x = e, known rho_1 = 0.4 only. The
+// AR(1) of what the known filter leaves is 0.6, and the composed filter is the AR(2) 1.0, -0.24.
+TEST(ResidualNoiseModel, KnownThenFittedAr1ComposesTheFilters) {
+  std::mt19937_64 rng(8201);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const int n = 20000;
+  Eigen::VectorXd x(4 * n);
+  for (int c = 0; c < 4; ++c) {
+    double x1 = 0.0, x2 = 0.0;
+    for (int t = 0; t < n; ++t) {
+      const double v = 1.0 * x1 - 0.24 * x2 + g(rng);
+      x[4 * t + c] = v;
+      x2 = x1;
+      x1 = v;
+    }
+  }
+  const ResidualNoiseModel known = noiseModelFromCorrelation({0.4}, 1);
+  ASSERT_EQ(known.ar.size(), 1u);
+  const ResidualNoiseModel m = withDetrendedAr1(known, x, 4);
+  ASSERT_EQ(m.ar.size(), 2u) << m.description;
+  const double b = m.ar[0] - 0.4;
+  EXPECT_NEAR(b, 0.6, 0.02) << m.description;
+  EXPECT_NEAR(m.ar[1], -0.4 * b, 1e-12);
+  EXPECT_NE(m.description.find("of what it leaves"), std::string::npos);
+  // White beyond the known part: the known model unchanged.
+  Eigen::VectorXd y(4 * n);
+  for (int c = 0; c < 4; ++c) {
+    double y1 = 0.0;
+    for (int t = 0; t < n; ++t) y[4 * t + c] = y1 = 0.4 * y1 + g(rng);
+  }
+  EXPECT_EQ(withDetrendedAr1(known, y, 4).ar.size(), 1u);
+}
+
 }  // namespace
 }  // namespace cvg_bench

@@ -47,6 +47,13 @@ ResidualNoiseModel noiseModelFromDetrendedResiduals(const Eigen::VectorXd& resid
                                                     int degree = 5, double ceiling = 0.95,
                                                     double min_rho = 0.05);
 
+/// `known` followed by an AR(1) of what it leaves: the residuals whitened by `known` (its first p
+/// samples per channel left out), noiseModelFromDetrendedResiduals of those, and the two filters
+/// composed, (1 - sum a_k L^k)(1 - b L) = 1 - sum c_j L^j, c_j = a_j - b a_{j-1} (a_0 = -1,
+/// a_{p+1} = 0). `known` itself when nothing is left or fewer than 16 samples a channel.
+ResidualNoiseModel withDetrendedAr1(const ResidualNoiseModel& known,
+                                    const Eigen::VectorXd& residuals, int channels);
+
 /// Applies the whitening filter to each channel (the first p samples of a channel use the
 /// available past only).
 Eigen::VectorXd whiten(const Eigen::VectorXd& residuals, int channels,
