@@ -407,7 +407,7 @@ class ForcedFitter : public NestedModelFitter {
   Linearized linearize(const NestedFit& fit) const {
     const ResonatorModel model =
         ResonatorModel(fit.extensions, ExperimentMode::kForced).linearPart();
-    const Eigen::VectorXd z = linearPart(fit);
+    const Eigen::VectorXd z = fit.scored_values.size() ? fit.scored_values : linearPart(fit);
     const SlowContext ctx{0.0, knownOrFittedMu(fit)};
     Linearized out;
     Eigen::VectorXd r(4 * record_.size());
@@ -508,6 +508,7 @@ class ForcedFitter : public NestedModelFitter {
       f->rss = rss;
       f->n_equations = static_cast<long>(yw.size());
       f->scored_residuals = r;
+      f->scored_values = z;
     }
   }
 

@@ -40,6 +40,9 @@ struct NestedFit {
   /// The residuals behind rss when they are not `residuals` (forced sweeps: whitened output
   /// errors, nested_model_fitters.h); the selection's c is computed from these.
   Eigen::VectorXd scored_residuals;
+  /// The linear part's z of that scoring fit, when it differs from the estimate's (forced: the
+  /// output-error GLS; the adequacy residuals are taken there).
+  Eigen::VectorXd scored_values;
 };
 
 /// Mode-specific fitting through the identification API (nested_model_fitters.h).
