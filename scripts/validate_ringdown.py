@@ -24,8 +24,9 @@ Thresholds (fixed before running): Q coverage of the 95 % interval in [0.90, 0.9
 detected (the right name selected; det_loss: `unexplained`) in >= 95 %; false alarms on clean
 records (any extension selected or `unexplained`) <= 5 %; floor found in >= 95 % of records with a
 floor and claimed in <= 5 % without. Rates carry Wilson 95 % intervals. Tuning runs use other seed
-bases than the reporting run (`--seed-base`; the reporting base is the default, 71829304, first
-used after tuning on bases 41000000, 42000000 and 43000000; 20261125 and 30261125 are spent).
+bases than the reporting run (`--seed-base`; the reporting base is the default, 88412207, first
+used after tuning on bases 41000000, 42000000 and 43000000; 20261125, 30261125 and 71829304 are
+spent). 60 records a class: a Wilson interval of +-0.06 at 0.95, enough to tell 0.90 from 0.98.
 
 Usage: validate_ringdown.py [--markdown FILE] [--n N] [--seed-base S] [--classes a,b] [--jobs J]
 """
@@ -161,13 +162,17 @@ def make_record(kind, seed, with_floor=True):
     u_end = plateau + decay_len
     spc = STEPS_PER_CYCLE
     tc = rng.uniform(0.8, 3.0)  # lock-in time constant [cycles]
-    truth = {"Q": Q, "f": f}
+    truth = {"Q": Q, "f": f, "tc_over_tau": tc / tau_u, "plateau": plateau > 0}
     span = math.log(10 ** ((-floor_db - 10) / 20)) / g0
     if kind == "gamma_nl":  # extra rate at switch-off 0.7 .. 2.5 x g0
-        x = oscillate(u_end, 1.0 / spc, g0, "nl", rng.uniform(0.7, 2.5) * g0, 1.0, plateau)
+        extra = rng.uniform(0.7, 2.5)
+        truth["extra"] = extra
+        x = oscillate(u_end, 1.0 / spc, g0, "nl", extra * g0, 1.0, plateau)
         z = lockin(x, spc, tc)
     elif kind == "gamma_a":
-        x = oscillate(u_end, 1.0 / spc, g0, "a", rng.uniform(0.7, 2.5) * g0, 1.0, plateau)
+        extra = rng.uniform(0.7, 2.5)
+        truth["extra"] = extra
+        x = oscillate(u_end, 1.0 / spc, g0, "a", extra * g0, 1.0, plateau)
         z = lockin(x, spc, tc)
     elif kind == "beat":  # a second mode 3 .. 15 beat periods over the span, in the same channel
         nu = rng.uniform(3, 15) / span
@@ -233,6 +238,68 @@ def write_record(path, t, y, idx, fmt, truth):
                 fh.write("%.12g\t%.6f\n" % (a, b))
 
 
+CHI2_95_1DOF = 3.841458820694124
+
+
+def ref_profile_q(t, a, f):
+    """Reference: the profile-likelihood Q of mdovale/RingDownAnalysis (ProfileQEstimator: tau
+    profiled on a log grid, the other coefficients linear least squares at each tau, interval where
+    dof ln(RSS(tau) / RSS_min) <= chi2_1(0.95); Q = pi f tau), applied to the envelope: model
+    A(t) = c1 exp(-t / tau) + c0 on the linear amplitude (their cos/sin pair becomes one
+    amplitude on an envelope), white-noise likelihood. Reimplemented from the formulas, not their
+    code. Returns (Q, low, high); low/high None where the profile does not close."""
+    t = t - t[0]
+    sl = np.polyfit(t, np.log(a), 1)[0]
+    tau0 = -1.0 / sl if sl < 0 else t[-1]
+    def rss(tau):
+        X = np.column_stack([np.exp(-t / tau), np.ones_like(t)])
+        c = np.linalg.lstsq(X, a, rcond=None)[0]
+        return float(np.sum((a - X @ c) ** 2))
+    lg = np.linspace(math.log(tau0 / 20), math.log(max(tau0 * 20, 100 * t[-1])), 321)
+    r = np.array([rss(math.exp(v)) for v in lg])
+    k = int(np.argmin(r))
+    fine = np.linspace(lg[max(k - 1, 0)], lg[min(k + 1, len(lg) - 1)], 41)
+    rf = np.array([rss(math.exp(v)) for v in fine])
+    kf = int(np.argmin(rf))
+    rmin = max(rf[kf], 1e-300)
+    lg_all = np.concatenate([lg, fine])
+    r_all = np.concatenate([r, rf])
+    o = np.argsort(lg_all)
+    lg_all, r_all = lg_all[o], r_all[o]
+    dof = len(t) - 2
+    delta = dof * np.log(np.maximum(r_all, 1e-300) / rmin)
+    best = int(np.argmin(np.abs(lg_all - fine[kf])))
+    def cross(i, j):
+        d0, d1 = delta[i], delta[j]
+        fr = 0.5 if d1 == d0 else min(1.0, max(0.0, (CHI2_95_1DOF - d0) / (d1 - d0)))
+        return math.exp(lg_all[i] + fr * (lg_all[j] - lg_all[i]))
+    lo = best
+    while lo > 0 and delta[lo - 1] <= CHI2_95_1DOF:
+        lo -= 1
+    hi = best
+    while hi < len(delta) - 1 and delta[hi + 1] <= CHI2_95_1DOF:
+        hi += 1
+    tau_lo = cross(lo, lo - 1) if lo > 0 else None
+    tau_hi = cross(hi, hi + 1) if hi < len(delta) - 1 else None
+    q = math.pi * f * math.exp(fine[kf])
+    return (q, math.pi * f * tau_lo if tau_lo else None, math.pi * f * tau_hi if tau_hi else None)
+
+
+def ref_envelope_q(t, a, f):
+    """Reference: the envelope diagnostic of mdovale/RingDownAnalysis (straight ordinary least
+    squares of ln A over the samples at or above 5 % of the largest, slope standard error
+    sigma / sqrt(Sxx)); the 95 % interval slope +- 1.96 se is ours (they report the se only)."""
+    keep = a >= 0.05 * np.max(a)
+    tt, la = t[keep] - t[keep][0], np.log(a[keep])
+    sl, ic = np.polyfit(tt, la, 1)
+    res = la - (sl * tt + ic)
+    se = math.sqrt(np.sum(res ** 2) / (len(tt) - 2)) / math.sqrt(np.sum((tt - tt.mean()) ** 2))
+    q = math.pi * f / -sl
+    lo = math.pi * f / (-sl + 1.96 * se)
+    hi = math.pi * f / (-sl - 1.96 * se) if -sl - 1.96 * se > 0 else None
+    return (q, lo, hi)
+
+
 def run_one(job):
     kind, seed, with_floor, tmp = job
     t, y, idx, fmt, truth = make_record(kind, seed, with_floor)
@@ -247,6 +314,13 @@ def run_one(job):
            "truth": truth, "fmt": int(fmt)}
     if p.returncode == 0:
         res["json"] = json.load(open(out))
+        if kind == "clean":  # the reference estimators on the span the tool used
+            seg = res["json"]["final"]["segment"]
+            keep = np.ones(len(t), bool)
+            keep[idx] = False
+            keep &= (t >= seg["t_start"]) & (t <= seg["t_end"]) & (y > 0)
+            res["ref"] = {"profile": ref_profile_q(t[keep], y[keep], truth["f"]),
+                          "envelope": ref_envelope_q(t[keep], y[keep], truth["f"])}
     else:
         res["err"] = p.stderr.strip()[-300:]
     os.remove(path)
@@ -263,11 +337,12 @@ def covered(v, truth):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--markdown")
-    ap.add_argument("--n", type=int, default=20, help="records per class")
-    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=71829304,
+    ap.add_argument("--n", type=int, default=60, help="records per class")
+    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=88412207,
                     help="first seed (the reporting run uses the default; tune on others)")
     ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated subset")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("VALIDATE_JOBS", "2")))
+    ap.add_argument("--dump", help="write every record's result (truth, JSON) to this file")
     a = ap.parse_args()
     if not os.path.exists(TOOL):
         sys.exit("validate_ringdown: bin/cvg_ident missing")
@@ -285,6 +360,9 @@ def main():
     with ThreadPoolExecutor(max_workers=a.jobs) as ex:
         results = list(ex.map(run_one, jobs))
     wall = time.time() - t0
+    if a.dump:
+        with open(a.dump, "w") as fh:
+            json.dump(results, fh)
     by = {k: [r for r in results if r["kind"] == k] for k in CLASSES}
     rows = []
     verdict_ok = True
@@ -328,6 +406,28 @@ def main():
         lo, hi = wilson(c, len(sel))
         extra.append("| %s coverage (%s records detected) | %d / %d | %.3f | [%.3f, %.3f] |" % (
             key, kind, c, len(sel), c / max(1, len(sel)), lo, hi))
+    # Reference estimators (mdovale/RingDownAnalysis formulas) on the same clean records and span.
+    refrows = []
+    def width(lo, hi):
+        return (hi - lo) if lo is not None and hi is not None else math.inf
+    tool_q = [(r["json"]["final"]["derived_ci"]["Q"], r["truth"]["Q"]) for r in ok_clean]
+    est = {"cvg_bench (explain, final model)": [(v["value"], v.get("ci_low"), v.get("ci_high")) for v, _ in tool_q]}
+    for key, name in [("profile", "profile likelihood on the envelope (RingDownAnalysis formula)"),
+                      ("envelope", "log-envelope OLS, 5 % threshold (RingDownAnalysis formula)")]:
+        est[name] = [tuple(r["ref"][key]) for r in ok_clean if "ref" in r]
+    tool_w = [width(v.get("ci_low"), v.get("ci_high")) for v, _ in tool_q]
+    for name, vals in est.items():
+        if len(vals) != len(ok_clean) or not vals:
+            continue
+        truths = [r["truth"]["Q"] for r in ok_clean]
+        closed = sum(lo is not None and hi is not None for _, lo, hi in vals)
+        cov_r = sum(lo is not None and hi is not None and lo <= tq <= hi for (_, lo, hi), tq in zip(vals, truths))
+        lo_w, hi_w = wilson(cov_r, len(vals))
+        err = [abs(q / tq - 1) for (q, _, _), tq in zip(vals, truths)]
+        wr = [width(lo, hi) / tw for (_, lo, hi), tw in zip(vals, tool_w) if tw > 0 and math.isfinite(tw)]
+        refrows.append("| %s | %d / %d | %d / %d | %.3f [%.3f, %.3f] | %.2f %% | %.2f |" % (
+            name, closed, len(vals), cov_r, len(vals), cov_r / len(vals), lo_w, hi_w,
+            100 * float(np.median(err)), float(np.median(wr)) if wr else math.nan))
     ratios = [r["json"]["final"]["cramer_rao"]["Q"]["interval_std_over_crb"] for r in ok_clean
               if "Q" in r["json"]["final"]["cramer_rao"]]
     rc_fail = [r for r in results if r["rc"] != 0]
@@ -338,11 +438,16 @@ def main():
           "and switched off, read through a simulated lock-in (2-pole low-pass, 0.8 .. 3 cycles) with "
           "white noise at its input (the floor, correlated after the filter) and AR(1) relative noise "
           "(coefficient up to 0.85); plateau, floor, drop-outs, three instrument formats, amplitude "
-          "scale 1e-5 .. 10. %d records per class, seed base %d (tuning used bases 41000000, 42000000, 43000000); "
+          "scale 1e-5 .. 10. %d records per class, seed base %d (tuning used bases 41000000, 42000000, 43000000; earlier reporting bases are spent); "
           "thresholds fixed in the script before the run. Tool: `cvg_ident explain INPUT --mode "
           "ringdown --json`. Command: `%s`." % (a.n, a.seed, " ".join(["scripts/validate_ringdown.py"] + sys.argv[1:])), "",
           "| check | count | rate | Wilson 95 % | target | |", "|---|---|---|---|---|---|"] + rows + [
           "", "Secondary (no target):", "", "| figure | count | rate | Wilson 95 % |", "|---|---|---|---|"] + extra + [
+          "", "Q on the clean records by cvg_bench and by the published formulas of the peer "
+          "`mdovale/RingDownAnalysis` reimplemented in this script (same records, same fitted span; "
+          "coverage counts only closed intervals containing the true Q):", "",
+          "| estimator | interval closed | covers true Q | coverage [Wilson 95 %] | median abs. Q error | median width / cvg_bench width |",
+          "|---|---|---|---|---|---|"] + refrows + [
           "", "Interval std (AR noise-model sandwich, or white when no correlation is detected, each parameter widened to the block check's cluster sandwich over 16 blocks where that is larger) / Cramer-Rao std of Q on clean records: median %.2f, 10-90 %% %.2f .. %.2f "
           "(the bound assumes white noise; the records' noise is coloured)." % (
               float(np.median(ratios)), float(np.percentile(ratios, 10)), float(np.percentile(ratios, 90)))
