@@ -84,7 +84,7 @@ the run (base 42000000, beat class, 60 records: 54 detected, 6 missed, plus the 
 1 and 1.5 and four phases, found the true split within 0.2 cycles per span in 6 of the 7. In 3
 of them it cut the line's sum of squares to 0.16, 0.26 and 0.37 of it where the tool's beat fit
 had reached 0.54, 0.58 and 0.68 (a start problem: the periodogram starts have equal rates,
-d2 = d1, and these second modes decay 1.4 .. 1.9x faster or slower); in 1 the tool's best beat
+d2 = d1, and these second modes decay 1.4 .. 1.6x slower than the first); in 1 the tool's best beat
 had a negative rate where the grid found a physical one at a similar fit; in 2 the tool's fit was
 as good and its AR-whitened criterion judged the beat not significant under the records'
 correlated noise. A split grid with unequal-rate starts is the next step for the beat (not done
