@@ -24,8 +24,9 @@ Thresholds (fixed before running): Q coverage of the 95 % interval in [0.90, 0.9
 detected (the right name selected; det_loss: `unexplained`) in >= 95 %; false alarms on clean
 records (any extension selected or `unexplained`) <= 5 %; floor found in >= 95 % of records with a
 floor and claimed in <= 5 % without. Rates carry Wilson 95 % intervals. Tuning runs use other seed
-bases than the reporting run (`--seed-base`; the reporting base is the default, 71829304, first
-used after tuning on bases 41000000, 42000000 and 43000000; 20261125 and 30261125 are spent).
+bases than the reporting run (`--seed-base`; the reporting base is the default, 88412207, first
+used after tuning on bases 41000000, 42000000 and 43000000; 20261125, 30261125 and 71829304 are
+spent). 60 records a class: a Wilson interval of +-0.06 at 0.95, enough to tell 0.90 from 0.98.
 
 Usage: validate_ringdown.py [--markdown FILE] [--n N] [--seed-base S] [--classes a,b] [--jobs J]
 """
@@ -59,7 +60,97 @@ The remaining miss was width: the AR(p <= 12) sandwich assumes one stationary co
 records carry relative noise early and the lock-in-filtered floor noise late. Each parameter's std is
 now the larger of the AR sandwich and a cluster sandwich of the scores over 16 contiguous blocks
 (Student df 16 - p where the blocks win); `interval_method` names both. The lack-of-fit test keeps
-the AR covariance alone (the blocks absorb a misfit localized in time)."""
+the AR covariance alone (the blocks absorb a misfit localized in time).
+
+## Before / after
+
+Before: the previous reporting run, 20 records a class on base 71829304 (the same tool as this
+run; only the run's size and the seed base changed): Q coverage 19/20 (0.950 [0.764, 0.991]),
+clean false alarms 1/20 (0.050 [0.009, 0.236]), gamma_nl 16/20 (0.800 [0.584, 0.919]), gamma_a
+20/20 (1.000 [0.839, 1.000]), beat 18/20 (0.900 [0.699, 0.972]), two_stage 18/20 (0.900 [0.699,
+0.972]), detection loss 20/20 (1.000 [0.839, 1.000]), floor found 13/14 (0.929 [0.685, 0.987]),
+floor claimed without one 0/6. After: the tables above (60 a class, fresh base). Twenty a class
+could not separate 0.90 from 0.98 coverage (interval width ~0.23); sixty narrows it to ~0.12.
+Run time of this run (base 88412207): 360 records in 680 s wall (11 min 21 s) with 2 jobs on the
+2-core machine while other jobs ran (load average ~4.5), 51 MB peak memory: the ring-down part of
+`make validate` fits its 30-minute budget. Read after the run (no tuning on it): 9 of the 11
+gamma_nl misses were called gamma_a (the close call explained below); the 5 beat misses were
+all left as a single exponential, 3 of them with the second mode decaying 1.5x slower than the
+first, and in 4 the beat fit found no modulation at all (criterion within its penalty of the
+line's): a start problem of the split search, not a threshold. Checked on tuning seeds after
+the run (base 42000000, beat class, 60 records: 54 detected, 6 missed, plus the one miss of base
+41000000): a plain least-squares fit of the beat envelope on ln A, started on a grid of splits
+(1.5 .. 30 cycles per span in steps of 0.25) with second-mode ratios 0.1 and 0.3, rate ratios 0.7,
+1 and 1.5 and four phases, found the true split within 0.2 cycles per span in 6 of the 7. In 3
+of them it cut the line's sum of squares to 0.16, 0.26 and 0.37 of it where the tool's beat fit
+had reached 0.54, 0.58 and 0.68 (a start problem: the periodogram starts have equal rates,
+d2 = d1, and these second modes decay 1.4 .. 1.6x slower than the first); in 1 the tool's best beat
+had a negative rate where the grid found a physical one at a similar fit; in 2 the tool's fit was
+as good and its AR-whitened criterion judged the beat not significant under the records'
+correlated noise. A split grid with unequal-rate starts is the next step for the beat (not done
+here: it changes the tool after this reporting run). The detection rows count the
+right name selected; the verdict table shows that the account is not always clean: 21 of the 55
+detected beats, 10 of the 57 two-stage decays and 2 + 2 of the amplitude laws also carry
+`unexplained` (the lack-of-fit test finds structure left in their residuals; its source was
+not analysed), and 14 of the 60 detection-loss records name a two-stage decay beside
+`unexplained`.
+
+## Why gamma_nl is the hard cause (tuning base 41000000, 30 records a class)
+
+The criterion difference BIC(gamma_nl) - BIC(gamma_a) was >= +12 on all 30 gamma_a records but
+spread from -317 to +9 on the gamma_nl records, 9 of them within +-6: the asymmetry is physical,
+not noise. A damping law in A^2 spends its extra rate in the first ~10 dB (the excess falls as
+e^{-2 g0 t}); a law in A keeps it over ~20 dB. The lock-in's low-pass rounds the corner at the
+drive-off over a few time constants (0.013 .. 0.075 of the decay time here), and the span skips
+that settling (at most 3 dB), which is where the A^2 law's signature lives; 3 of the 4 records
+without a plateau (the corner at the first sample) were among the 5 misses. Tried and rejected
+on the tuning seeds: (1) skipping less (half the settling time): gamma_nl 23/30, gamma_a 28/30,
+worse; (2) fitting from the drive-off with the 2-pole filter's transient in every model
+(ln(1 - k (2 + x) e^{-x}), x = (t - t_off) / tau_f, k >= 0 and tau_f fitted): gamma_nl 9/30, gamma_a
+16/30: the transient and the law's early curvature trade off, and a model that rejects the
+transient (k < 0) is left with an unmodelled corner that the lack-of-fit test flags. Taking the
+best start with positive rates for the beat and two-stage fits changed no verdict on 30 + 30
+tuning records (left out). A model of the instrument's filter (order and time constant from the
+plateau's corner, convolved with each law) is the next step; it is not done.
+
+## Comparison with mdovale/RingDownAnalysis
+
+What the peer computes (read from its source; no code taken): on a raw time-domain ring-down
+(phasemeter exports) it fits x = A e^{-t/tau} cos(2 pi f t + phi) by nonlinear least squares and
+by a DFT with a Lorentzian peak fit, and gives the Cramer-Rao bound of the frequency from the
+explicit Fisher information (weighted sums of e^{-2 t / tau} t^k); its profile-likelihood Q fixes
+f, solves the cos, sin and offset coefficients by linear least squares at each tau on a 161-point
+log grid refined by a bounded scalar search, and takes the 95 % interval where
+dof ln(RSS(tau) / RSS_min) <= 3.84 (white noise), reporting a one-sided limit when the profile
+does not close (`profile_open_high`, `profile_min_at_lower_tau_bound`, ...); Q = pi f tau as
+here. An envelope diagnostic fits ln of a sliding peak-to-peak amplitude over windows at or above
+5 % of the largest (3-MAD rejection) and checks a candidate Q against it. Its nonlinear model is
+one law, 1/tau(A) = 1/tau0 + beta A (the Bernoulli closed form, our gamma_a), with Q0 = pi f0
+tau0 and a frequency pull f(A) = f0 + pull A, fitted on segmented-demodulation amplitudes. Named
+violations: regimes `coherent_short`, `long_or_drifting`, `plateau_dominated` (limits only, never a
+finite Q), `cross_estimator_disagreement` (estimates more than 1.5x apart), `nonlinear_beta_at_bound`,
+`nonlinear_amplitude_span_below_two_efolds`.
+
+On the same kind of record: the peer gives f with its bound (cvg_bench takes f from the file or
+the option and does not estimate it from a raw waveform beyond demodulating it), Q with a
+white-noise profile interval or a limit, the A-law and a frequency pull. cvg_bench gives Q with
+an interval under correlated residuals (AR / block sandwich, the white-noise bound beside it),
+segments plateau, floor and drop-outs itself, puts the floor in the model, chooses a log or an
+additive error model from the data, bins Q against amplitude, and names more causes: the A^2 law
+beside the A law, a beat of two close modes (split, both Q), a two-stage decay and an
+unexplained (accelerating) decay. It does less on frequency: no frequency estimate, no frequency
+pull, no frequency bound.
+
+The table above puts the peer's two published Q formulas, reimplemented here
+(`ref_profile_q`, `ref_envelope_q`, known-answer tests in test/python/test_ringdown_reference.py),
+on the clean records and the span cvg_bench chose (its segmentation given to them: the peer's
+own plateau handling is in its demodulation stage, not in these formulas). The profile formula is
+applied to the linear envelope with amplitude and offset linear (the envelope's form of its
+cos/sin/offset projection); the envelope formula's +-1.96 se interval is ours (the peer reports the
+se only). Both assume white noise; the records' noise is coloured (lock-in filter, AR(1) relative
+noise), which is what their coverage shows: on base 88412207 both give Q as accurate as cvg_bench
+(median error 0.28 % and 0.15 % against 0.13 %) with intervals 0.64x and 0.35x as wide that
+contain the true Q in 50 % and 47 % of the records, where cvg_bench's contain it in 95 %."""
 
 
 def wilson(k, n, z=1.96):
@@ -161,13 +252,17 @@ def make_record(kind, seed, with_floor=True):
     u_end = plateau + decay_len
     spc = STEPS_PER_CYCLE
     tc = rng.uniform(0.8, 3.0)  # lock-in time constant [cycles]
-    truth = {"Q": Q, "f": f}
+    truth = {"Q": Q, "f": f, "tc_over_tau": tc / tau_u, "plateau": plateau > 0}
     span = math.log(10 ** ((-floor_db - 10) / 20)) / g0
     if kind == "gamma_nl":  # extra rate at switch-off 0.7 .. 2.5 x g0
-        x = oscillate(u_end, 1.0 / spc, g0, "nl", rng.uniform(0.7, 2.5) * g0, 1.0, plateau)
+        extra = rng.uniform(0.7, 2.5)
+        truth["extra"] = extra
+        x = oscillate(u_end, 1.0 / spc, g0, "nl", extra * g0, 1.0, plateau)
         z = lockin(x, spc, tc)
     elif kind == "gamma_a":
-        x = oscillate(u_end, 1.0 / spc, g0, "a", rng.uniform(0.7, 2.5) * g0, 1.0, plateau)
+        extra = rng.uniform(0.7, 2.5)
+        truth["extra"] = extra
+        x = oscillate(u_end, 1.0 / spc, g0, "a", extra * g0, 1.0, plateau)
         z = lockin(x, spc, tc)
     elif kind == "beat":  # a second mode 3 .. 15 beat periods over the span, in the same channel
         nu = rng.uniform(3, 15) / span
@@ -233,6 +328,68 @@ def write_record(path, t, y, idx, fmt, truth):
                 fh.write("%.12g\t%.6f\n" % (a, b))
 
 
+CHI2_95_1DOF = 3.841458820694124
+
+
+def ref_profile_q(t, a, f):
+    """Reference: the profile-likelihood Q of mdovale/RingDownAnalysis (ProfileQEstimator: tau
+    profiled on a log grid, the other coefficients linear least squares at each tau, interval where
+    dof ln(RSS(tau) / RSS_min) <= chi2_1(0.95); Q = pi f tau), applied to the envelope: model
+    A(t) = c1 exp(-t / tau) + c0 on the linear amplitude (their cos/sin pair becomes one
+    amplitude on an envelope), white-noise likelihood. Reimplemented from the formulas, not their
+    code. Returns (Q, low, high); low/high None where the profile does not close."""
+    t = t - t[0]
+    sl = np.polyfit(t, np.log(a), 1)[0]
+    tau0 = -1.0 / sl if sl < 0 else t[-1]
+    def rss(tau):
+        X = np.column_stack([np.exp(-t / tau), np.ones_like(t)])
+        c = np.linalg.lstsq(X, a, rcond=None)[0]
+        return float(np.sum((a - X @ c) ** 2))
+    lg = np.linspace(math.log(tau0 / 20), math.log(max(tau0 * 20, 100 * t[-1])), 321)
+    r = np.array([rss(math.exp(v)) for v in lg])
+    k = int(np.argmin(r))
+    fine = np.linspace(lg[max(k - 1, 0)], lg[min(k + 1, len(lg) - 1)], 41)
+    rf = np.array([rss(math.exp(v)) for v in fine])
+    kf = int(np.argmin(rf))
+    rmin = max(rf[kf], 1e-300)
+    lg_all = np.concatenate([lg, fine])
+    r_all = np.concatenate([r, rf])
+    o = np.argsort(lg_all)
+    lg_all, r_all = lg_all[o], r_all[o]
+    dof = len(t) - 2
+    delta = dof * np.log(np.maximum(r_all, 1e-300) / rmin)
+    best = int(np.argmin(np.abs(lg_all - fine[kf])))
+    def cross(i, j):
+        d0, d1 = delta[i], delta[j]
+        fr = 0.5 if d1 == d0 else min(1.0, max(0.0, (CHI2_95_1DOF - d0) / (d1 - d0)))
+        return math.exp(lg_all[i] + fr * (lg_all[j] - lg_all[i]))
+    lo = best
+    while lo > 0 and delta[lo - 1] <= CHI2_95_1DOF:
+        lo -= 1
+    hi = best
+    while hi < len(delta) - 1 and delta[hi + 1] <= CHI2_95_1DOF:
+        hi += 1
+    tau_lo = cross(lo, lo - 1) if lo > 0 else None
+    tau_hi = cross(hi, hi + 1) if hi < len(delta) - 1 else None
+    q = math.pi * f * math.exp(fine[kf])
+    return (q, math.pi * f * tau_lo if tau_lo else None, math.pi * f * tau_hi if tau_hi else None)
+
+
+def ref_envelope_q(t, a, f):
+    """Reference: the envelope diagnostic of mdovale/RingDownAnalysis (straight ordinary least
+    squares of ln A over the samples at or above 5 % of the largest, slope standard error
+    sigma / sqrt(Sxx)); the 95 % interval slope +- 1.96 se is ours (they report the se only)."""
+    keep = a >= 0.05 * np.max(a)
+    tt, la = t[keep] - t[keep][0], np.log(a[keep])
+    sl, ic = np.polyfit(tt, la, 1)
+    res = la - (sl * tt + ic)
+    se = math.sqrt(np.sum(res ** 2) / (len(tt) - 2)) / math.sqrt(np.sum((tt - tt.mean()) ** 2))
+    q = math.pi * f / -sl
+    lo = math.pi * f / (-sl + 1.96 * se)
+    hi = math.pi * f / (-sl - 1.96 * se) if -sl - 1.96 * se > 0 else None
+    return (q, lo, hi)
+
+
 def run_one(job):
     kind, seed, with_floor, tmp = job
     t, y, idx, fmt, truth = make_record(kind, seed, with_floor)
@@ -247,6 +404,13 @@ def run_one(job):
            "truth": truth, "fmt": int(fmt)}
     if p.returncode == 0:
         res["json"] = json.load(open(out))
+        if kind == "clean":  # the reference estimators on the span the tool used
+            seg = res["json"]["final"]["segment"]
+            keep = np.ones(len(t), bool)
+            keep[idx] = False
+            keep &= (t >= seg["t_start"]) & (t <= seg["t_end"]) & (y > 0)
+            res["ref"] = {"profile": ref_profile_q(t[keep], y[keep], truth["f"]),
+                          "envelope": ref_envelope_q(t[keep], y[keep], truth["f"])}
     else:
         res["err"] = p.stderr.strip()[-300:]
     os.remove(path)
@@ -263,11 +427,15 @@ def covered(v, truth):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--markdown")
-    ap.add_argument("--n", type=int, default=20, help="records per class")
-    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=71829304,
+    ap.add_argument("--n", type=int, default=60, help="records per class")
+    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=88412207,
                     help="first seed (the reporting run uses the default; tune on others)")
     ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated subset")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("VALIDATE_JOBS", "2")))
+    ap.add_argument("--dump", help="write every record's result (truth, JSON) to this file")
+    ap.add_argument("--from-dump", help="render the tables from a --dump file of a finished run "
+                    "(no records are run; --wall gives that run's wall time [s])")
+    ap.add_argument("--wall", type=float, default=math.nan)
     a = ap.parse_args()
     if not os.path.exists(TOOL):
         sys.exit("validate_ringdown: bin/cvg_ident missing")
@@ -282,9 +450,17 @@ def main():
             with_floor = not (kind == "clean" and i % 10 < 3)
             jobs.append((kind, seed, with_floor, tmp))
     t0 = time.time()
-    with ThreadPoolExecutor(max_workers=a.jobs) as ex:
-        results = list(ex.map(run_one, jobs))
-    wall = time.time() - t0
+    if a.from_dump:
+        with open(a.from_dump) as fh:
+            results = json.load(fh)
+        wall = a.wall
+    else:
+        with ThreadPoolExecutor(max_workers=a.jobs) as ex:
+            results = list(ex.map(run_one, jobs))
+        wall = time.time() - t0
+    if a.dump:
+        with open(a.dump, "w") as fh:
+            json.dump(results, fh)
     by = {k: [r for r in results if r["kind"] == k] for k in CLASSES}
     rows = []
     verdict_ok = True
@@ -328,6 +504,44 @@ def main():
         lo, hi = wilson(c, len(sel))
         extra.append("| %s coverage (%s records detected) | %d / %d | %.3f | [%.3f, %.3f] |" % (
             key, kind, c, len(sel), c / max(1, len(sel)), lo, hi))
+    # Reference estimators (mdovale/RingDownAnalysis formulas) on the same clean records and span.
+    refrows = []
+    def width(lo, hi):
+        return (hi - lo) if lo is not None and hi is not None else math.inf
+    tool_q = [(r["json"]["final"]["derived_ci"]["Q"], r["truth"]["Q"]) for r in ok_clean]
+    est = {"cvg_bench (explain, final model)": [(v["value"], v.get("ci_low"), v.get("ci_high")) for v, _ in tool_q]}
+    for key, name in [("profile", "profile likelihood on the envelope (RingDownAnalysis formula)"),
+                      ("envelope", "log-envelope OLS, 5 % threshold (RingDownAnalysis formula)")]:
+        est[name] = [tuple(r["ref"][key]) for r in ok_clean if "ref" in r]
+    tool_w = [width(v.get("ci_low"), v.get("ci_high")) for v, _ in tool_q]
+    for name, vals in est.items():
+        if len(vals) != len(ok_clean) or not vals:
+            continue
+        truths = [r["truth"]["Q"] for r in ok_clean]
+        closed = sum(lo is not None and hi is not None for _, lo, hi in vals)
+        cov_r = sum(lo is not None and hi is not None and lo <= tq <= hi for (_, lo, hi), tq in zip(vals, truths))
+        lo_w, hi_w = wilson(cov_r, len(vals))
+        err = [abs(q / tq - 1) for (q, _, _), tq in zip(vals, truths)]
+        wr = [width(lo, hi) / tw for (_, lo, hi), tw in zip(vals, tool_w) if tw > 0 and math.isfinite(tw)]
+        refrows.append("| %s | %d / %d | %d / %d | %.3f [%.3f, %.3f] | %.2f %% | %.2f |" % (
+            name, closed, len(vals), cov_r, len(vals), cov_r / len(vals), lo_w, hi_w,
+            100 * float(np.median(err)), float(np.median(wr)) if wr else math.nan))
+    # What each class was called (selected extension, "+unexplained" when flagged; "exit N" for a
+    # refusal).
+    confusion = []
+    for kind in CLASSES:
+        counts = {}
+        for r in by[kind]:
+            if r["rc"] != 0:
+                lab = "exit %d" % r["rc"]
+            else:
+                lab = "+".join(r["json"]["selected"]) or "linear"
+                if r["json"]["unexplained"]:
+                    lab += " +unexplained"
+            counts[lab] = counts.get(lab, 0) + 1
+        if by[kind]:
+            confusion.append("| %s | %s |" % (kind, ", ".join(
+                "%s %d" % (k, v) for k, v in sorted(counts.items(), key=lambda kv: -kv[1]))))
     ratios = [r["json"]["final"]["cramer_rao"]["Q"]["interval_std_over_crb"] for r in ok_clean
               if "Q" in r["json"]["final"]["cramer_rao"]]
     rc_fail = [r for r in results if r["rc"] != 0]
@@ -338,11 +552,18 @@ def main():
           "and switched off, read through a simulated lock-in (2-pole low-pass, 0.8 .. 3 cycles) with "
           "white noise at its input (the floor, correlated after the filter) and AR(1) relative noise "
           "(coefficient up to 0.85); plateau, floor, drop-outs, three instrument formats, amplitude "
-          "scale 1e-5 .. 10. %d records per class, seed base %d (tuning used bases 41000000, 42000000, 43000000); "
+          "scale 1e-5 .. 10. %d records per class, seed base %d (tuning used bases 41000000, 42000000, 43000000; earlier reporting bases are spent); "
           "thresholds fixed in the script before the run. Tool: `cvg_ident explain INPUT --mode "
-          "ringdown --json`. Command: `%s`." % (a.n, a.seed, " ".join(["scripts/validate_ringdown.py"] + sys.argv[1:])), "",
+          "ringdown --json`. Command: `scripts/validate_ringdown.py --n %d --seed-base %d --markdown docs/validation_ringdown.md` (`make validate`)." % (a.n, a.seed, a.n, a.seed), "",
           "| check | count | rate | Wilson 95 % | target | |", "|---|---|---|---|---|---|"] + rows + [
           "", "Secondary (no target):", "", "| figure | count | rate | Wilson 95 % |", "|---|---|---|---|"] + extra + [
+          "", "Verdicts per class (selected extension; linear = none; +unexplained where flagged):", "",
+          "| class | verdicts |", "|---|---|"] + confusion + [
+          "", "Q on the clean records by cvg_bench and by the published formulas of the peer "
+          "`mdovale/RingDownAnalysis` reimplemented in this script (same records, same fitted span; "
+          "coverage counts only closed intervals containing the true Q):", "",
+          "| estimator | interval closed | covers true Q | coverage [Wilson 95 %] | median abs. Q error | median width / cvg_bench width |",
+          "|---|---|---|---|---|---|"] + refrows + [
           "", "Interval std (AR noise-model sandwich, or white when no correlation is detected, each parameter widened to the block check's cluster sandwich over 16 blocks where that is larger) / Cramer-Rao std of Q on clean records: median %.2f, 10-90 %% %.2f .. %.2f "
           "(the bound assumes white noise; the records' noise is coloured)." % (
               float(np.median(ratios)), float(np.percentile(ratios, 10)), float(np.percentile(ratios, 90)))
