@@ -284,7 +284,8 @@ class FreeDecayFitter : public NestedModelFitter {
   /// by the noisy q inside D-bar (errors in variables) and its residuals are correlated
   /// (docs/paper.md items 10, 15), which makes clean data look like a significant xi; the
   /// output-error residuals are the measurement noise itself, so the Wald test on its covariance is
-  /// honest. The equation residuals (for the signature) are those of (2.8) at the refined z.
+  /// honest. The equation residuals (for the signature) are those of (2.8) at the refined z; a
+  /// refined fit does not keep them (4 doubles a sample each): blocks() makes them when asked.
   NestedFit fitOn(const SlowRecord& record, const std::vector<std::string>& extensions) const {
     PipelineOptions p;
     p.method = Method::kCeres;
@@ -299,10 +300,10 @@ class FreeDecayFitter : public NestedModelFitter {
     f.estimate = identify(record, p);
     f.model = f.estimate.model;
     const ResonatorModel model(extensions, ExperimentMode::kFreeDecay);
-    f.residuals = equationResidualsStreamed(model, f.estimate.values, record);
-    f.n_equations = static_cast<long>(f.residuals.size());
     f.sigma = f.estimate.sigma;
     if (f.estimate.method != methodName(Method::kCeres)) {
+      f.residuals = equationResidualsStreamed(model, f.estimate.values, record);
+      f.n_equations = static_cast<long>(f.residuals.size());
       f.rss = f.residuals.squaredNorm();
       return f;
     }

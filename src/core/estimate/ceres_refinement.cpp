@@ -32,6 +32,7 @@ std::vector<std::string> CeresOptions::validate() const {
   if (!(parameter_tolerance > 0)) p.push_back("parameter_tolerance must be > 0");
   if (!(gradient_tolerance > 0)) p.push_back("gradient_tolerance must be > 0");
   if (rk4_substeps < 1 || rk4_substeps > 1000) p.push_back("rk4_substeps must be in 1..1000");
+  if (coarse_samples < 0) p.push_back("coarse_samples must be >= 0");
   if (!std::isfinite(known_mu)) p.push_back("known_mu must be finite");
   if (!std::isfinite(mu_start)) p.push_back("mu_start must be finite");
   if (!(max_dropped_fraction >= 0 && max_dropped_fraction < 1))
@@ -492,6 +493,36 @@ std::string solverNote(const ceres::Solver::Summary& summary) {
   return s.str();
 }
 
+/// Stride of the coarse start (CeresOptions::coarse_samples): record size / coarse_samples,
+/// capped so that one RK4 step on the coarse grid times the fastest slow rate (the largest
+/// singular value of A = slowJacobian (2.6) at the first sample and the start z; amplitude terms
+/// only shrink as the record decays) stays <= 0.05 (RK4 error per step ~ 0.05^5 / 120).
+size_t coarseStride(const ResonatorModel& model, const Eigen::VectorXd& z, const SlowRecord& record,
+                    const CeresOptions& options) {
+  const size_t n = record.size();
+  if (options.coarse_samples <= 0 || n < 4 * static_cast<size_t>(options.coarse_samples)) return 1;
+  size_t stride = n / static_cast<size_t>(options.coarse_samples);
+  const double step_s = (record.t_s.back() - record.t_s.front()) /
+                        (static_cast<double>(n - 1) * options.rk4_substeps);
+  const Eigen::Matrix4d a = model.slowJacobian(record.q.front(), SlowContext{0.0, 0.0}, z);
+  const double rate = Eigen::JacobiSVD<Eigen::Matrix4d>(a).singularValues()[0];
+  if (rate > 0.0 && step_s > 0.0)
+    stride = std::min<size_t>(stride, static_cast<size_t>(std::max(1.0, 0.05 / (rate * step_s))));
+  return std::max<size_t>(1, stride);
+}
+
+/// Every `stride`-th sample from the first (same t0, so q(t0) means the same).
+SlowRecord everyNth(const SlowRecord& record, size_t stride) {
+  SlowRecord coarse;
+  coarse.omega_rad_s = record.omega_rad_s;
+  coarse.source = record.source;
+  for (size_t i = 0; i < record.size(); i += stride) {
+    coarse.t_s.push_back(record.t_s[i]);
+    coarse.q.push_back(record.q[i]);
+  }
+  return coarse;
+}
+
 const char* kSigmaNote =
     "sigma is the RMS misfit of the measured slow variables (units of q), not the equation units "
     "of the LS sigma-hat (2.10)";
@@ -529,6 +560,32 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
   if (!(q0_scale > 0)) q0_scale = 1.0;
   Eigen::VectorXd z = z_start.cwiseQuotient(z_scale);
   Eigen::Vector4d q0 = record.q.front() / q0_scale;
+  // A long record: the same problem on every s-th sample first (a start near the optimum costs
+  // the whole record a few iterations instead of tens).
+  std::string coarse_note;
+  const size_t stride = coarseStride(model, z_start, record, options);
+  if (stride > 1) {
+    const SlowRecord coarse = everyNth(record, stride);
+    ceres::Problem coarse_problem;
+    Eigen::VectorXd zc = z;
+    Eigen::Vector4d qc = q0;
+    coarse_problem.AddResidualBlock(
+        makeFreeDecaySquareRootCost(model, coarse, options.rk4_substeps, z_scale, q0_scale)
+            .release(),
+        nullptr, zc.data(), qc.data());
+    ceres::Solver::Summary coarse_summary;
+    try {
+      solveOrThrow(&coarse_problem, options, &coarse_summary);
+      z = zc;
+      q0 = qc;
+      coarse_note = "start from the same fit on every " + std::to_string(stride) + "th sample (" +
+                    std::to_string(coarse.size()) + " samples, " +
+                    std::to_string(coarse_summary.iterations.size() - 1) + " iterations)";
+    } catch (const AnalysisError& err) {
+      coarse_note = std::string("the fit on every ") + std::to_string(stride) +
+                    "th sample failed, started from the given estimate: " + err.what();
+    }
+  }
   // Solved in square-root form (k + 5 residuals, the per-sample rows folded as they are made);
   // rank and covariance from the per-sample problem below.
   ceres::Problem square_root;
@@ -558,6 +615,7 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
   e.notes.push_back("fitted initial slow variables q(t0) = " + formatQ(q0_fitted.data()) +
                     " (4 nuisance unknowns, not in parameters)");
   e.notes.push_back(kSigmaNote);
+  if (!coarse_note.empty()) e.notes.push_back(coarse_note);
   e.notes.push_back(solverNote(summary));
 
   // The final Jacobian (covariance, rank) comes from the same exact sensitivities.

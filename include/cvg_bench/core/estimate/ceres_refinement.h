@@ -1,8 +1,8 @@
 // Output-error refinement of an equation-error (LS) estimate with Ceres (`--method ceres`).
 //
 // The equation-error LS of (2.7)-(2.9) / (3.4)-(3.5) puts the noisy measured q inside the regressor
-// D(q), which biases it (errors in variables, docs/paper.md item 15) and correlates its equation errors
-// (item 10). The output-error fit removes both by comparing measured q with the MODEL's q:
+// D(q), which biases it (errors in variables, docs/paper.md item 15) and correlates its equation
+// errors (item 10). The output-error fit removes both by comparing measured q with the MODEL's q:
 //  - free decay: q_model(t_i) integrates the averaged equations (2.6), 2 q' = D(q) z, by RK4 on the
 //    record's time grid from fitted initial slow variables q(t_0) (4 nuisance unknowns);
 //  - forced sweep: q_model(omega0_j) is the stationary point of (3.3), 0 = D(q) z - rate_j y(q),
@@ -36,6 +36,11 @@ struct CeresOptions {
   /// Free decay: RK4 steps per interval of the record's time grid, 1..1000 (raise it when the
   /// record is sampled coarsely relative to the slow rates).
   int rk4_substeps = 1;
+  /// Free decay: a record of at least 4x this many samples is first fitted on every s-th sample
+  /// (s ~ record size / coarse_samples, capped so that RK4 on the coarser grid stays accurate), a
+  /// cheap start; the fit on the whole record continues from there with the tolerances above, so
+  /// the answer is the whole record's optimum either way. 0 = never.
+  int coarse_samples = 20000;
   /// Known control nonlinearity mu [1/amplitude^2] used when the model spec has no `mu`; forced
   /// mode only (free decay has no drive).
   double known_mu = 0.0;
