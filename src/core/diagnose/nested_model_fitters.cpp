@@ -204,7 +204,7 @@ class FreeDecayFitter : public NestedModelFitter {
     SlowRecord train = record_;
     train.t_s.assign(record_.t_s.begin(), record_.t_s.begin() + split);
     train.q.assign(record_.q.begin(), record_.q.begin() + split);
-    const Estimate e = fitOn(train, extensions).estimate;
+    const Estimate e = fitOn(train, extensions).estimate;  // values only: never finished
     const ResonatorModel model(extensions, ExperimentMode::kFreeDecay);
     ParameterValues values;
     for (size_t i = 0; i < e.names.size(); ++i) values[e.names[i]] = e.values[i];
@@ -297,7 +297,10 @@ class FreeDecayFitter : public NestedModelFitter {
     p.on_ceres_failure = CeresFailure::kKeepStart;
     NestedFit f;
     f.extensions = extensions;
-    f.estimate = identify(record, p);
+    // Covariance deferred: most refined fits are only ranked (NestedFit::finish).
+    DeferredEstimate d = identifyDeferred(record, p);
+    f.estimate = std::move(d.estimate);
+    f.finish = std::move(d.finish);
     f.model = f.estimate.model;
     const ResonatorModel model(extensions, ExperimentMode::kFreeDecay);
     f.sigma = f.estimate.sigma;

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct NestedFit {
   double rss = 0.0;                     ///< residual sum of squares of the equations
   long n_equations = 0;
   Eigen::VectorXd residuals;  ///< equation residuals y - D z (4 per block)
+  /// Set when the estimate's covariance and intervals were deferred (a refined fit that may only
+  /// be ranked): returns the complete estimate (the same sigma, rss and values).
+  std::function<Estimate()> finish;
 };
 
 /// Mode-specific fitting through the identification API (nested_model_fitters.h).

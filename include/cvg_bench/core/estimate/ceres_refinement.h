@@ -13,6 +13,7 @@
 // sigma^2 = 2 cost / (n - rank); Student-t intervals as in (2.11). sigma is in units of q.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,23 @@ struct CeresOptions {
 /// matching its model, invalid options); AnalysisError when Ceres finds no usable solution.
 Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
                          const CeresOptions& options = CeresOptions());
+
+/// The same in two steps: the constructor solves (errors as above); solved() has the values,
+/// sigma, rank, dof and notes of the solve but no covariance or intervals (enough to rank a
+/// model or to predict with it); finish() adds the covariance, intervals, identifiability and
+/// derived quantities and returns what refineWithCeres returns. The record must outlive the
+/// object and its copies (they share the solved state).
+class FreeDecayRefinement {
+ public:
+  FreeDecayRefinement(const SlowRecord& record, const Estimate& start,
+                      const CeresOptions& options = CeresOptions());
+  const Estimate& solved() const;
+  Estimate finish() const;
+
+ private:
+  struct State;
+  std::shared_ptr<const State> state_;
+};
 
 /// Output-error refinement of a forced-sweep estimate (stationary points of (3.3)); omega from
 /// start.omega_rad_s, else record.omega_rad_s (InputError when neither is > 0). Estimates mu
