@@ -38,8 +38,8 @@ auto praisWinstenRow(const Row& x, long i, double rho) {
 /// are), row by row: the factor of [b | y] folded in chunks (IncrementalQr), the coefficients by
 /// the column-pivoted QR of its triangle, the residual sum by a second pass; nothing of size n is
 /// copied. Returns the coefficients; *rss0 = |y_w|^2, *rss1 = |y_w - b_w coef|^2, *rank.
-Eigen::VectorXd whitenedLeastSquares(const Eigen::MatrixXd& b, const Eigen::VectorXd& y,
-                                     double rho, double* rss0, double* rss1, int* rank) {
+Eigen::VectorXd whitenedLeastSquares(const Eigen::MatrixXd& b, const Eigen::VectorXd& y, double rho,
+                                     double* rss0, double* rss1, int* rank) {
   const long n = b.rows(), k = b.cols();
   auto brow = [&](long i) { return b.row(i); };
   auto yval = [&](long i) { return Eigen::Matrix<double, 1, 1>(y[i]); };

@@ -274,9 +274,14 @@ class FreeDecayFitter : public NestedModelFitter {
     if (integrateSlowTrajectory(model, z, q0, record_.t_s, options_.rk4_substeps, &traj) &&
         traj.size() == n)
       for (size_t i = 0; i < n; ++i) r0.segment<4>(4 * i) = record_.q[i] - traj[i];
+    else
+      traj = record_.q;
     std::vector<double> t(n);
     for (size_t i = 0; i < n; ++i) t[i] = record_.t_s[i] - record_.t_s.front();
-    return blockResiduals(r0, record_.q, t, {});
+    // Radial and tangential parts along the MODEL's state: projected on the measured q, the
+    // radial part e.q/|q| = (e.q_model + |e|^2)/|q| has the mean 3 sigma^2/|q|, a smooth trend as
+    // the decay lowers |q| that the low-frequency test finds in long records.
+    return blockResiduals(r0, traj, t, {});
   }
 
  private:
