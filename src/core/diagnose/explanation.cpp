@@ -74,8 +74,9 @@ std::vector<std::pair<std::string, std::vector<double>>> sequences(
   return s;
 }
 
-LackOfFit lackOfFit(ExperimentMode mode, std::vector<BlockResidual> blocks) {
+LackOfFit lackOfFit(ExperimentMode mode, const std::vector<BlockResidual>& in) {
   if (mode == ExperimentMode::kForced) {
+    std::vector<BlockResidual> blocks = in;
     std::stable_sort(
         blocks.begin(), blocks.end(),
         [](const BlockResidual& a, const BlockResidual& b) { return a.abscissa < b.abscissa; });
@@ -86,9 +87,9 @@ LackOfFit lackOfFit(ExperimentMode mode, std::vector<BlockResidual> blocks) {
   }
   // Trajectory residuals, decimated to at most ~200 values per sequence (demodulated records
   // carry noise correlated over the filter length).
-  const size_t stride = std::max<size_t>(1, (blocks.size() + 199) / 200);
+  const size_t stride = std::max<size_t>(1, (in.size() + 199) / 200);
   std::vector<BlockResidual> used;
-  for (size_t i = 0; i < blocks.size(); i += stride) used.push_back(blocks[i]);
+  for (size_t i = 0; i < in.size(); i += stride) used.push_back(in[i]);
   return combinedRuns(
       "Wald-Wolfowitz runs test of the output-error (trajectory) residuals "
       "q_measured - q_model, every " +

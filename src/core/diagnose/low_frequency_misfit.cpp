@@ -8,6 +8,7 @@
 
 #include "cvg_bench/core/diagnose/model_diagnosis.h"
 #include "cvg_bench/core/estimate/fitted_residual_ar1.h"
+#include "cvg_bench/core/estimate/least_squares_solver.h"
 
 namespace cvg_bench {
 namespace {
@@ -27,13 +28,48 @@ Eigen::MatrixXd legendreBasis(const std::vector<double>& t, int degree) {
   return b;
 }
 
-/// Prais-Winsten AR(1) whitening: w_0 = sqrt(1 - rho^2) x_0, w_t = x_t - rho x_{t-1}.
-Eigen::MatrixXd praisWinsten(const Eigen::MatrixXd& x, double rho) {
-  Eigen::MatrixXd w(x.rows(), x.cols());
-  if (x.rows() == 0) return w;
-  w.row(0) = std::sqrt(1.0 - rho * rho) * x.row(0);
-  for (long i = 1; i < x.rows(); ++i) w.row(i) = x.row(i) - rho * x.row(i - 1);
-  return w;
+/// Prais-Winsten AR(1) whitening of row i: w_0 = sqrt(1 - rho^2) x_0, w_i = x_i - rho x_{i-1}.
+template <typename Row>
+auto praisWinstenRow(const Row& x, long i, double rho) {
+  return i == 0 ? (std::sqrt(1.0 - rho * rho) * x(0)).eval() : (x(i) - rho * x(i - 1)).eval();
+}
+
+/// Least squares of y on the columns of b, both Prais-Winsten whitened at rho (rho = 0: as they
+/// are), row by row: the factor of [b | y] folded in chunks (IncrementalQr), the coefficients by
+/// the column-pivoted QR of its triangle, the residual sum by a second pass; nothing of size n is
+/// copied. Returns the coefficients; *rss0 = |y_w|^2, *rss1 = |y_w - b_w coef|^2, *rank.
+Eigen::VectorXd whitenedLeastSquares(const Eigen::MatrixXd& b, const Eigen::VectorXd& y, double rho,
+                                     double* rss0, double* rss1, int* rank) {
+  const long n = b.rows(), k = b.cols();
+  auto brow = [&](long i) { return b.row(i); };
+  auto yval = [&](long i) { return Eigen::Matrix<double, 1, 1>(y[i]); };
+  IncrementalQr qr(static_cast<int>(k));
+  constexpr long kChunk = 4096;
+  Eigen::MatrixXd a(kChunk, k);
+  Eigen::VectorXd v(kChunk);
+  double ss = 0.0;
+  for (long r0 = 0; r0 < n; r0 += kChunk) {
+    const long len = std::min(kChunk, n - r0);
+    for (long i = 0; i < len; ++i) {
+      a.row(i) = praisWinstenRow(brow, r0 + i, rho);
+      v[i] = praisWinstenRow(yval, r0 + i, rho)(0);
+      ss += v[i] * v[i];
+    }
+    qr.addRows(a.topRows(len), v.head(len));
+  }
+  const Eigen::MatrixXd& ra = qr.rAug();
+  const Eigen::MatrixXd r = ra.topLeftCorner(k, k).triangularView<Eigen::Upper>();
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> small(r);
+  const Eigen::VectorXd coef = small.solve(Eigen::VectorXd(ra.col(k).head(k)));
+  double res = 0.0;
+  for (long i = 0; i < n; ++i) {
+    const double e = praisWinstenRow(yval, i, rho)(0) - praisWinstenRow(brow, i, rho).dot(coef);
+    res += e * e;
+  }
+  *rss0 = ss;
+  *rss1 = res;
+  *rank = static_cast<int>(small.rank());
+  return coef;
 }
 
 Eigen::VectorXd knownWhitened(const Eigen::VectorXd& x, const ResidualNoiseModel& known) {
@@ -64,14 +100,23 @@ double lowFrequencyPValue(const std::vector<double>& x, const std::vector<double
   // The first p filtered values lack their full past (not whitened): conditional on them.
   const long skip = static_cast<long>(known.ar.size());
   if (n - skip < 4 * k) return 1.0;
-  y = y.tail(n - skip).eval();
-  b = b.bottomRows(n - skip).eval();
+  if (skip > 0) {
+    y = y.tail(n - skip).eval();
+    b = b.bottomRows(n - skip).eval();
+  }
   // AR(1) of what the smooth basis leaves (Yule-Walker lag-1 correlation).
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(b);
-  const Eigen::VectorXd u = y - b * qr.solve(y);
+  double rss0 = 0.0, rss1 = 0.0;
+  int rank = 0;
+  const Eigen::VectorXd coef = whitenedLeastSquares(b, y, 0.0, &rss0, &rss1, &rank);
   const long m = y.size();
-  const double c0 = u.squaredNorm();
-  double rho = c0 > 0.0 ? u.head(m - 1).dot(u.tail(m - 1)) / c0 : 0.0;
+  double c0 = 0.0, c1 = 0.0, previous = 0.0;
+  for (long i = 0; i < m; ++i) {
+    const double u = y[i] - b.row(i).dot(coef);
+    c0 += u * u;
+    if (i > 0) c1 += u * previous;
+    previous = u;
+  }
+  double rho = c0 > 0.0 ? c1 / c0 : 0.0;
   // Removing the smooth part removes slow noise too: the lag-1 correlation of u understates
   // rho; corrected by its expectation under that projection (fitted_residual_ar1.h).
   const Eigen::MatrixXd gram_inv =
@@ -82,12 +127,7 @@ double lowFrequencyPValue(const std::vector<double>& x, const std::vector<double
     if (capped) *capped = true;
   }
   if (rho_used) *rho_used = rho;
-  const Eigen::VectorXd w = praisWinsten(y, rho);
-  const Eigen::MatrixXd wb = praisWinsten(b, rho);
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> wqr(wb);
-  const double rss0 = w.squaredNorm();
-  const double rss1 = (w - wb * wqr.solve(w)).squaredNorm();
-  const int rank = static_cast<int>(wqr.rank());
+  whitenedLeastSquares(b, y, rho, &rss0, &rss1, &rank);
   if (!(rss1 > 0.0) || rank < 1 || m - rank < 1) return rss0 > 0.0 ? 0.0 : 1.0;
   const double f = ((rss0 - rss1) / rank) / (rss1 / static_cast<double>(m - rank));
   return fUpperTail(f, rank, static_cast<int>(m - rank));

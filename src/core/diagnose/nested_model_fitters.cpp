@@ -205,7 +205,7 @@ class FreeDecayFitter : public NestedModelFitter {
     SlowRecord train = record_;
     train.t_s.assign(record_.t_s.begin(), record_.t_s.begin() + split);
     train.q.assign(record_.q.begin(), record_.q.begin() + split);
-    const Estimate e = fitOn(train, extensions).estimate;
+    const Estimate e = fitOn(train, extensions).estimate;  // values only: never finished
     const ResonatorModel model(extensions, ExperimentMode::kFreeDecay);
     ParameterValues values;
     for (size_t i = 0; i < e.names.size(); ++i) values[e.names[i]] = e.values[i];
@@ -275,9 +275,14 @@ class FreeDecayFitter : public NestedModelFitter {
     if (integrateSlowTrajectory(model, z, q0, record_.t_s, options_.rk4_substeps, &traj) &&
         traj.size() == n)
       for (size_t i = 0; i < n; ++i) r0.segment<4>(4 * i) = record_.q[i] - traj[i];
+    else
+      traj = record_.q;
     std::vector<double> t(n);
     for (size_t i = 0; i < n; ++i) t[i] = record_.t_s[i] - record_.t_s.front();
-    return blockResiduals(r0, record_.q, t, {});
+    // Radial and tangential parts along the MODEL's state: projected on the measured q, the
+    // radial part e.q/|q| = (e.q_model + |e|^2)/|q| has the mean 3 sigma^2/|q|, a smooth trend as
+    // the decay lowers |q| that the low-frequency test finds in long records.
+    return blockResiduals(r0, traj, t, {});
   }
 
  private:
@@ -285,7 +290,8 @@ class FreeDecayFitter : public NestedModelFitter {
   /// by the noisy q inside D-bar (errors in variables) and its residuals are correlated
   /// (docs/paper.md items 10, 15), which makes clean data look like a significant xi; the
   /// output-error residuals are the measurement noise itself, so the Wald test on its covariance is
-  /// honest. The equation residuals (for the signature) are those of (2.8) at the refined z.
+  /// honest. The equation residuals (for the signature) are those of (2.8) at the refined z; a
+  /// refined fit does not keep them (4 doubles a sample each): blocks() makes them when asked.
   NestedFit fitOn(const SlowRecord& record, const std::vector<std::string>& extensions) const {
     PipelineOptions p;
     p.method = Method::kCeres;
@@ -297,13 +303,16 @@ class FreeDecayFitter : public NestedModelFitter {
     p.on_ceres_failure = CeresFailure::kKeepStart;
     NestedFit f;
     f.extensions = extensions;
-    f.estimate = identify(record, p);
+    // Covariance deferred: most refined fits are only ranked (NestedFit::finish).
+    DeferredEstimate d = identifyDeferred(record, p);
+    f.estimate = std::move(d.estimate);
+    f.finish = std::move(d.finish);
     f.model = f.estimate.model;
     const ResonatorModel model(extensions, ExperimentMode::kFreeDecay);
-    f.residuals = equationResidualsStreamed(model, f.estimate.values, record);
-    f.n_equations = static_cast<long>(f.residuals.size());
     f.sigma = f.estimate.sigma;
     if (f.estimate.method != methodName(Method::kCeres)) {
+      f.residuals = equationResidualsStreamed(model, f.estimate.values, record);
+      f.n_equations = static_cast<long>(f.residuals.size());
       f.rss = f.residuals.squaredNorm();
       return f;
     }

@@ -160,6 +160,28 @@ class SubsetSearch {
       store(key(todo[i]), &refined_, true, std::move(fits[i]), errors[i]);
   }
 
+  /// The refined fit with its covariance and intervals (NestedFit::finish run once); for the
+  /// fits the result reports (baseline, steps, near misses), the others are only ranked.
+  const NestedFit* complete(const Terms& t) {
+    const NestedFit* f = refined(t);
+    if (f && f->finish) completeAll({t});
+    return f;
+  }
+  /// complete() of each of `batch`, several at a time.
+  void completeAll(const std::vector<Terms>& batch) {
+    std::vector<NestedFit*> todo;
+    for (const auto& t : batch) {
+      const auto it = refined_.find(key(t));
+      if (it != refined_.end() && it->second.finish &&
+          std::find(todo.begin(), todo.end(), &it->second) == todo.end())
+        todo.push_back(&it->second);
+    }
+    runTasks(todo.size(), options_.threads, [&](size_t i) {
+      todo[i]->estimate = todo[i]->finish();
+      todo[i]->finish = nullptr;
+    });
+  }
+
   /// The hold-outs of `batch` not computed yet, several at a time; as holdout() in batch order.
   void holdoutAll(const std::vector<Terms>& batch) {
     std::vector<Terms> todo;
@@ -448,8 +470,19 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
                                       }),
                        result.dropped.end());
 
-  // 4. Steps ladder, runner-up, subset table.
-  const NestedFit* prev = fitOf({});
+  // 4. Steps ladder, runner-up, subset table. The fits reported get their intervals: the
+  // baseline, the chosen subset and its refined one-term extensions (at once), the ladder's.
+  const Terms chosen_sorted = search.canonical(chosen);
+  std::vector<Terms> reported = {{}, chosen_sorted};
+  for (const auto& name : search.names()) {
+    Terms t = chosen_sorted;
+    if (std::find(t.begin(), t.end(), name) != t.end()) continue;
+    t.push_back(name);
+    t = search.canonical(t);
+    if (crit.count(key(t))) reported.push_back(t);
+  }
+  search.completeAll(reported);
+  const NestedFit* prev = search.complete({});
   if (!prev) prev = base_cheap;
   result.baseline = *prev;
   Terms prefix;
@@ -473,7 +506,7 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     }
     Terms next = prefix;
     next.push_back(add);
-    const NestedFit* f = fitOf(search.canonical(next));
+    const NestedFit* f = search.complete(search.canonical(next));
     if (!f) break;
     SelectionStep s;
     s.added = add;
@@ -505,7 +538,7 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     t.push_back(name);
     t = search.canonical(t);
     if (!crit.count(key(t)) || !std::isfinite(crit[key(t)])) continue;
-    const NestedFit* f = fitOf(t);
+    const NestedFit* f = search.complete(t);
     SelectionStep s;
     s.added = name;
     s.fit = *f;

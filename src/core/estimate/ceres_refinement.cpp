@@ -32,6 +32,7 @@ std::vector<std::string> CeresOptions::validate() const {
   if (!(parameter_tolerance > 0)) p.push_back("parameter_tolerance must be > 0");
   if (!(gradient_tolerance > 0)) p.push_back("gradient_tolerance must be > 0");
   if (rk4_substeps < 1 || rk4_substeps > 1000) p.push_back("rk4_substeps must be in 1..1000");
+  if (coarse_samples < 0) p.push_back("coarse_samples must be >= 0");
   if (!std::isfinite(known_mu)) p.push_back("known_mu must be finite");
   if (!std::isfinite(mu_start)) p.push_back("mu_start must be finite");
   if (!(max_dropped_fraction >= 0 && max_dropped_fraction < 1))
@@ -133,29 +134,46 @@ std::string fmt3(double v) {
   return s.str();
 }
 
-/// Residuals, Jacobian (unscaled unknowns) and unknowns at the solution.
+/// Lag-1 correlation of the residual 4-blocks (one sample / sweep point apart).
+double blockLagOne(const Eigen::VectorXd& r) {
+  const long n = r.size();
+  const double ss = r.squaredNorm();
+  if (n <= 8 || !(ss > 0.0)) return 0.0;
+  return r.tail(n - 4).dot(r.head(n - 4)) / ss;
+}
+
+/// The dense Jacobian at the solution holds 4N x p doubles (the solve itself holds nothing of
+/// size N): refinements running concurrently (explain's batches of candidate fits) take turns
+/// for it, so that the peak memory stays that of one; the results do not depend on the order.
+std::mutex& denseJacobianTurn() {
+  static std::mutex turn;
+  return turn;
+}
+
+/// Residuals, Jacobian (unscaled unknowns) and unknowns at the solution. Free decay: n, p, cost
+/// and lag1 come from the solve's pass at the solution, and the per-sample rows (j, residuals)
+/// are written only when a noise model needs them (dense()).
 struct AtSolution {
+  long n = 0;  ///< residuals
+  int p = 0;   ///< unknowns
   Eigen::MatrixXd j;
   Eigen::VectorXd residuals;
   Eigen::VectorXd x;      ///< all unknowns, unscaled
   Eigen::VectorXd scale;  ///< blocks hold x / scale
   double cost = 0.0;
+  double lag1 = 0.0;  ///< lag-1 correlation of the residual 4-blocks (blockLagOne)
+  std::unique_lock<std::mutex> turn;
 };
 
+/// a->j and a->residuals, written once (free decay: by the forward sensitivities).
+void dense(const FittedProblem& fp, AtSolution* a) {
+  if (a->j.size() > 0 || !fp.evaluate_dense) return;
+  a->turn = std::unique_lock<std::mutex>(denseJacobianTurn());
+  if (!fp.evaluate_dense(&a->j, &a->residuals))
+    throw AnalysisError("Ceres refinement: residuals cannot be evaluated at the solution");
+}
+
 AtSolution evaluateAtSolution(const FittedProblem& fp) {
-  if (fp.evaluate_dense) {
-    AtSolution a;
-    if (!fp.evaluate_dense(&a.j, &a.residuals))
-      throw AnalysisError("Ceres refinement: residuals cannot be evaluated at the solution");
-    a.cost = 0.5 * a.residuals.squaredNorm();
-    a.scale = fp.scale.size() == a.j.cols() ? fp.scale : Eigen::VectorXd::Ones(a.j.cols());
-    a.x.resize(a.j.cols());
-    for (size_t b = 0, o = 0; b < fp.blocks.size(); o += fp.block_sizes[b], ++b)
-      a.x.segment(o, fp.block_sizes[b]) =
-          Eigen::Map<const Eigen::VectorXd>(fp.blocks[b], fp.block_sizes[b]);
-    a.x = a.x.cwiseProduct(a.scale);
-    return a;
-  }
   ceres::Problem::EvaluateOptions eo;
   eo.parameter_blocks = fp.blocks;
   AtSolution a;
@@ -174,6 +192,9 @@ AtSolution evaluateAtSolution(const FittedProblem& fp) {
     a.x.segment(o, fp.block_sizes[b]) =
         Eigen::Map<const Eigen::VectorXd>(fp.blocks[b], fp.block_sizes[b]);
   a.x = a.x.cwiseProduct(a.scale);
+  a.n = a.j.rows();
+  a.p = static_cast<int>(a.j.cols());
+  a.lag1 = blockLagOne(a.residuals);
   return a;
 }
 
@@ -213,12 +234,28 @@ RankAnalysis numericalRank(const Eigen::MatrixXd& j, double tolerance) {
   return r;
 }
 
+/// The same from the triangular factor R of J (J = Q R: the same column norms, and R D the same
+/// singular values and V as J D), e.g. folded sample by sample by the solve.
+RankAnalysis rankFromFactor(const Eigen::MatrixXd& factor, double tolerance) {
+  RankAnalysis r;
+  r.norms = factor.colwise().norm().transpose();
+  for (Eigen::Index c = 0; c < r.norms.size(); ++c)
+    if (r.norms[c] == 0.0) r.norms[c] = 1.0;
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(factor * r.norms.cwiseInverse().asDiagonal(),
+                                              Eigen::ComputeFullV);
+  r.s = svd.singularValues();
+  r.v = svd.matrixV();
+  for (Eigen::Index i = 0; i < r.s.size(); ++i)
+    if (r.s[i] > tolerance * r.s[0]) ++r.rank;
+  return r;
+}
+
 /// (J'J)^+ in the unscaled unknowns: ceres::Covariance, or the truncated SVD of the
 /// column-equilibrated Jacobian where Ceres refuses.
 Eigen::MatrixXd unscaledCovariance(const FittedProblem& fp, const AtSolution& a,
                                    const RankAnalysis& r, const CeresOptions& options,
                                    Estimate* e) {
-  const int p = static_cast<int>(a.j.cols());
+  const int p = a.p;
   const char* kRefusedNote =
       "covariance from the SVD of the column-equilibrated Jacobian (ceres::Covariance judged "
       "J'J too ill-conditioned before equilibration)";
@@ -253,14 +290,6 @@ Eigen::MatrixXd unscaledCovariance(const FittedProblem& fp, const AtSolution& a,
   e->notes.push_back(kRefusedNote);
   return r.norms.cwiseInverse().asDiagonal() * v * inv_s2.asDiagonal() * v.transpose() *
          r.norms.cwiseInverse().asDiagonal();
-}
-
-/// Lag-1 correlation of the residual 4-blocks (one sample / sweep point apart).
-double blockLagOne(const Eigen::VectorXd& r) {
-  const long n = r.size();
-  const double ss = r.squaredNorm();
-  if (n <= 8 || !(ss > 0.0)) return 0.0;
-  return r.tail(n - 4).dot(r.head(n - 4)) / ss;
 }
 
 /// J' Sigma J for residual rows 4 per sample, Sigma_{i,i+4l} = rho_l (l = 1..rho.size(), 4 l < n):
@@ -308,9 +337,9 @@ struct CeresCovariance {
   std::string method, id;
 };
 
-CeresCovariance outputErrorCovariance(const FittedProblem& fp, const AtSolution& a,
+CeresCovariance outputErrorCovariance(const FittedProblem& fp, AtSolution& a,
                                       const Eigen::MatrixXd& unscaled, int dof, Estimate* e) {
-  const long n = a.j.rows();
+  const long n = a.n;
   CeresCovariance out;
   out.cov = (2.0 * a.cost / dof) * unscaled;
   out.id = "iid";
@@ -320,7 +349,7 @@ CeresCovariance outputErrorCovariance(const FittedProblem& fp, const AtSolution&
   for (size_t l = 0; l < fp.noise_correlation.size(); ++l)
     factor += 2.0 * fp.noise_correlation[l] * fp.noise_correlation[l];
   if (!fp.noise_correlation.empty()) expected = fp.noise_correlation[0];
-  const SerialCorrelationTest test = testLagOne(blockLagOne(a.residuals), expected, factor, n / 4);
+  const SerialCorrelationTest test = testLagOne(a.lag1, expected, factor, n / 4);
   e->residual_lag1 = test.lag1;
   e->residual_lag1_expected = test.expected;
   e->residual_lag1_z = test.z;
@@ -337,13 +366,15 @@ CeresCovariance outputErrorCovariance(const FittedProblem& fp, const AtSolution&
       // The fit removes mostly slow noise, so the residuals' lag-1 correlation understates rho:
       // corrected by its expectation under the fit (fitted_residual_ar1.h).
       rho.clear();
+      dense(fp, &a);
       const double r1 = std::min(fittedResidualAr1(a.j, unscaled, 4, test.lag1), 0.995);
       for (double v = r1; v > 1e-3 && static_cast<long>(rho.size()) < n / 8; v *= r1)
         rho.push_back(v);
       source = "AR(1) fitted to the residuals' lag-1 correlation " + fmt3(test.lag1) +
                " (corrected for the fit)";
       id = "ar1_fitted";
-    } else if (n / 4 > 3 * a.j.cols()) {
+    } else if (n / 4 > 3 * a.p) {
+      dense(fp, &a);
       const HacCovariance hac = hacCovarianceBlocked(a.j, a.residuals, 4);
       out.cov = hac.covariance;
       out.id = "hac_bartlett_andrews";
@@ -356,6 +387,7 @@ CeresCovariance outputErrorCovariance(const FittedProblem& fp, const AtSolution&
   if (rho.empty()) return out;
   // Noise correlation Sigma (same channel, samples l apart: rho_l): with C = (J'J)^+ and
   // S = J' Sigma J, cov = sigma^2 C S C and E[RSS] = sigma^2 (n - tr(C S)).
+  dense(fp, &a);
   const Eigen::MatrixXd s_mat = correlatedGram(a.j, rho);
   const double effective_dof = n - (unscaled * s_mat).trace();
   if (!(effective_dof > 0.0)) {
@@ -381,7 +413,7 @@ CeresCovariance outputErrorCovariance(const FittedProblem& fp, const AtSolution&
 /// Exact rank deficiency (identifiability.h) or near-collinearity (collinearity.h).
 void fillIdentifiability(const FittedProblem& fp, const AtSolution& a, const RankAnalysis& r,
                          const Eigen::MatrixXd& cov, double s_p, Estimate* e) {
-  const int p = static_cast<int>(a.j.cols());
+  const int p = a.p;
   e->unidentifiable.clear();
   e->not_identified.clear();
   e->identifiability_note.clear();
@@ -411,7 +443,7 @@ void fillIdentifiability(const FittedProblem& fp, const AtSolution& a, const Ran
 void fillIntervals(const FittedProblem& fp, const AtSolution& a, const RankAnalysis& r,
                    const CeresCovariance& cc, const CeresOptions& options, double s_p,
                    Estimate* e) {
-  const int n = static_cast<int>(a.j.rows()), p = static_cast<int>(a.j.cols());
+  const int n = static_cast<int>(a.n), p = a.p;
   const int k = fp.n_reported;
   const int dof = n - r.rank;
   e->method = "ceres";
@@ -435,25 +467,19 @@ void fillIntervals(const FittedProblem& fp, const AtSolution& a, const RankAnaly
   e->rank_tolerance = options.rank_tolerance;
 }
 
-/// The dense Jacobian at the solution holds 4N x p doubles (the solve itself holds nothing of
-/// size N): refinements running concurrently (explain's batches of candidate fits) take turns
-/// here, so that the peak memory stays that of one; the results do not depend on the order.
-std::mutex& denseJacobianTurn() {
-  static std::mutex turn;
-  return turn;
+void requireDegreesOfFreedom(long n, int rank) {
+  if (n - rank < 1)
+    throw AnalysisError("Ceres refinement: no degrees of freedom left (" + std::to_string(n) +
+                        " residuals, rank " + std::to_string(rank) + ")");
 }
 
-/// Rank, covariance (outputErrorCovariance), intervals (fillIntervals), identifiability and
-/// derived quantities of the fitted problem.
-void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estimate* e) {
-  const std::lock_guard<std::mutex> turn(denseJacobianTurn());
-  const AtSolution a = evaluateAtSolution(fp);
-  const int n = static_cast<int>(a.j.rows());
-  const RankAnalysis r = numericalRank(a.j, options.rank_tolerance);
+/// Covariance (outputErrorCovariance), intervals (fillIntervals), identifiability and derived
+/// quantities of the fitted problem, given its rank.
+void finishEstimate(const FittedProblem& fp, const CeresOptions& options, AtSolution a,
+                    const RankAnalysis& r, Estimate* e) {
+  const int n = static_cast<int>(a.n);
+  requireDegreesOfFreedom(n, r.rank);
   const int dof = n - r.rank;
-  if (dof < 1)
-    throw AnalysisError("Ceres refinement: no degrees of freedom left (" + std::to_string(n) +
-                        " residuals, rank " + std::to_string(r.rank) + ")");
   const Eigen::MatrixXd unscaled = unscaledCovariance(fp, a, r, options, e);
   const CeresCovariance cc = outputErrorCovariance(fp, a, unscaled, dof, e);
   const double s_p = studentQuantile(options.confidence, dof);
@@ -462,6 +488,13 @@ void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estima
   e->derived.clear();
   e->derived_method.clear();
   if (options.derive_quantities) deriveFromIdentified(e, e->omega_rad_s, options.angular_gain_k);
+}
+
+/// Forced sweeps: the Jacobian evaluated densely through the problem, then as above.
+void finishEstimate(const FittedProblem& fp, const CeresOptions& options, Estimate* e) {
+  AtSolution a = evaluateAtSolution(fp);
+  const RankAnalysis r = numericalRank(a.j, options.rank_tolerance);
+  finishEstimate(fp, options, std::move(a), r, e);
 }
 
 void checkTimes(const SlowRecord& record) {
@@ -492,19 +525,66 @@ std::string solverNote(const ceres::Solver::Summary& summary) {
   return s.str();
 }
 
+/// Stride of the coarse start (CeresOptions::coarse_samples): record size / coarse_samples,
+/// capped so that one RK4 step on the coarse grid times the fastest slow rate (the largest
+/// singular value of A = slowJacobian (2.6) at the first sample and the start z; amplitude terms
+/// only shrink as the record decays) stays <= 0.05 (RK4 error per step ~ 0.05^5 / 120).
+size_t coarseStride(const ResonatorModel& model, const Eigen::VectorXd& z, const SlowRecord& record,
+                    const CeresOptions& options) {
+  const size_t n = record.size();
+  if (options.coarse_samples <= 0 || n < 4 * static_cast<size_t>(options.coarse_samples)) return 1;
+  size_t stride = n / static_cast<size_t>(options.coarse_samples);
+  const double step_s = (record.t_s.back() - record.t_s.front()) /
+                        (static_cast<double>(n - 1) * options.rk4_substeps);
+  const Eigen::Matrix4d a = model.slowJacobian(record.q.front(), SlowContext{0.0, 0.0}, z);
+  const double rate = Eigen::JacobiSVD<Eigen::Matrix4d>(a).singularValues()[0];
+  if (rate > 0.0 && step_s > 0.0)
+    stride = std::min<size_t>(stride, static_cast<size_t>(std::max(1.0, 0.05 / (rate * step_s))));
+  return std::max<size_t>(1, stride);
+}
+
+/// Every `stride`-th sample from the first (same t0, so q(t0) means the same).
+SlowRecord everyNth(const SlowRecord& record, size_t stride) {
+  SlowRecord coarse;
+  coarse.omega_rad_s = record.omega_rad_s;
+  coarse.source = record.source;
+  for (size_t i = 0; i < record.size(); i += stride) {
+    coarse.t_s.push_back(record.t_s[i]);
+    coarse.q.push_back(record.q[i]);
+  }
+  return coarse;
+}
+
 const char* kSigmaNote =
     "sigma is the RMS misfit of the measured slow variables (units of q), not the equation units "
     "of the LS sigma-hat (2.10)";
 
 }  // namespace
 
-Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
-                         const CeresOptions& options) {
+/// What the free-decay finish needs of the solve.
+struct FreeDecayRefinement::State {
+  const SlowRecord* record = nullptr;
+  CeresOptions options;
+  ResonatorModel model{"linear", ExperimentMode::kFreeDecay};
+  Eigen::VectorXd z, z_scale;  ///< solution (scaled block) and scale
+  Eigen::Vector4d q0 = Eigen::Vector4d::Zero();
+  double q0_scale = 1.0;
+  SquareRootPass pass;     ///< the pass over the record at the solution
+  Eigen::MatrixXd factor;  ///< R of J with respect to the unscaled unknowns
+  Estimate solved;
+};
+
+FreeDecayRefinement::FreeDecayRefinement(const SlowRecord& record, const Estimate& start,
+                                         const CeresOptions& options) {
   requireValid(options);
   if (start.mode != ExperimentMode::kFreeDecay)
     throw InputError("refineWithCeres: start estimate is not a free-decay estimate");
-  const ResonatorModel model(start.model.empty() ? "linear" : start.model,
-                             ExperimentMode::kFreeDecay);
+  auto st = std::make_shared<State>();
+  st->record = &record;
+  st->options = options;
+  st->model =
+      ResonatorModel(start.model.empty() ? "linear" : start.model, ExperimentMode::kFreeDecay);
+  const ResonatorModel& model = st->model;
   checkTimes(record);
   const int k = model.numParameters();
   if (4 * static_cast<int>(record.size()) <= k + 4)
@@ -515,7 +595,8 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
   // Unknowns scaled to O(1): z_j = z_scale_j x_j with z_scale_j = max(|start_j|, its standard
   // error), q(t0) = q0_scale x_q with q0_scale = the record's largest |q|.
   const Eigen::VectorXd z_start = startVector(model, start);
-  Eigen::VectorXd z_scale(k);
+  Eigen::VectorXd& z_scale = st->z_scale;
+  z_scale.resize(k);
   for (int i = 0; i < k; ++i) {
     const auto it = start.parameters.find(model.parameterNames()[i]);
     const double se = it != start.parameters.end() && std::isfinite(it->second.std_error)
@@ -524,27 +605,69 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
     z_scale[i] = std::max(std::abs(z_start[i]), se);
     if (!(z_scale[i] > 0)) z_scale[i] = 1.0;
   }
-  double q0_scale = 0.0;
+  double& q0_scale = st->q0_scale;
+  q0_scale = 0.0;
   for (const auto& q : record.q) q0_scale = std::max(q0_scale, q.norm());
   if (!(q0_scale > 0)) q0_scale = 1.0;
-  Eigen::VectorXd z = z_start.cwiseQuotient(z_scale);
-  Eigen::Vector4d q0 = record.q.front() / q0_scale;
-  // Solved in square-root form (k + 5 residuals, the per-sample rows folded as they are made);
-  // rank and covariance from the per-sample problem below.
+  Eigen::VectorXd& z = st->z;
+  Eigen::Vector4d& q0 = st->q0;
+  z = z_start.cwiseQuotient(z_scale);
+  q0 = record.q.front() / q0_scale;
+  // A long record: the same problem on every s-th sample first (a start near the optimum costs
+  // the whole record a few iterations instead of tens).
+  std::string coarse_note;
+  const size_t stride = coarseStride(model, z_start, record, options);
+  if (stride > 1) {
+    const SlowRecord coarse = everyNth(record, stride);
+    ceres::Problem coarse_problem;
+    Eigen::VectorXd zc = z;
+    Eigen::Vector4d qc = q0;
+    coarse_problem.AddResidualBlock(
+        makeFreeDecaySquareRootCost(model, coarse, options.rk4_substeps, z_scale, q0_scale)
+            .release(),
+        nullptr, zc.data(), qc.data());
+    ceres::Solver::Summary coarse_summary;
+    try {
+      solveOrThrow(&coarse_problem, options, &coarse_summary);
+      z = zc;
+      q0 = qc;
+      coarse_note = "start from the same fit on every " + std::to_string(stride) + "th sample (" +
+                    std::to_string(coarse.size()) + " samples, " +
+                    std::to_string(coarse_summary.iterations.size() - 1) + " iterations)";
+    } catch (const AnalysisError& err) {
+      coarse_note = std::string("the fit on every ") + std::to_string(stride) +
+                    "th sample failed, started from the given estimate: " + err.what();
+    }
+  }
+  // Solved in square-root form (k + 5 residuals, the per-sample rows folded as they are made).
+  // Its last pass with Jacobians is normally at the solution: rank, sigma and the residuals'
+  // lag-1 correlation come from it (else from one more pass there).
   ceres::Problem square_root;
-  square_root.AddResidualBlock(
-      makeFreeDecaySquareRootCost(model, record, options.rk4_substeps, z_scale, q0_scale).release(),
-      nullptr, z.data(), q0.data());
+  auto cost = makeFreeDecaySquareRootCost(model, record, options.rk4_substeps, z_scale, q0_scale,
+                                          &st->pass);
+  ceres::CostFunction* cost_ptr = cost.get();
+  square_root.AddResidualBlock(cost.release(), nullptr, z.data(), q0.data());
   ceres::Solver::Summary summary;
   solveOrThrow(&square_root, options, &summary);
-  ceres::Problem problem;
-  problem.AddResidualBlock(
-      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps,
-                                   TrajectoryDerivative::kSensitivity, z_scale, q0_scale)
-          .release(),
-      nullptr, z.data(), q0.data());
+  Eigen::VectorXd x(k + 4);
+  x << z, q0;
+  if (st->pass.x.size() != x.size() || st->pass.x != x) {
+    std::vector<double> residuals(k + 5), jz((k + 5) * k), jq((k + 5) * 4);
+    const double* params[2] = {z.data(), q0.data()};
+    double* jacobians[2] = {jz.data(), jq.data()};
+    if (!cost_ptr->Evaluate(params, residuals.data(), jacobians) || st->pass.x != x)
+      throw AnalysisError("Ceres refinement: residuals cannot be evaluated at the solution");
+  }
+  Eigen::VectorXd scale(k + 4);
+  scale << z_scale, Eigen::Vector4d::Constant(q0_scale);
+  st->factor = st->pass.r_aug.topLeftCorner(k + 4, k + 4).triangularView<Eigen::Upper>();
+  st->factor = st->factor * scale.cwiseInverse().asDiagonal();
+  const RankAnalysis r = rankFromFactor(st->factor, options.rank_tolerance);
+  const long n = 4 * static_cast<long>(record.size());
+  requireDegreesOfFreedom(n, r.rank);
 
-  Estimate e = start;
+  Estimate& e = st->solved;
+  e = start;
   e.mode = ExperimentMode::kFreeDecay;
   e.model = model.spec();
   if (e.omega_rad_s <= 0) e.omega_rad_s = record.omega_rad_s;
@@ -558,9 +681,49 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
   e.notes.push_back("fitted initial slow variables q(t0) = " + formatQ(q0_fitted.data()) +
                     " (4 nuisance unknowns, not in parameters)");
   e.notes.push_back(kSigmaNote);
+  if (!coarse_note.empty()) e.notes.push_back(coarse_note);
   e.notes.push_back(solverNote(summary));
+  // Without the covariance yet: values, sigma, rank and dof (as fillIntervals sets them).
+  e.method = "ceres";
+  e.n_equations = static_cast<int>(n);
+  e.n_params = k;
+  e.rank = std::max(0, r.rank - 4);
+  e.dof = static_cast<int>(n) - r.rank;
+  e.sigma = std::sqrt(st->pass.ss / e.dof);
+  e.confidence = options.confidence;
+  e.names = model.parameterNames();
+  e.values = z.cwiseProduct(z_scale);
+  e.covariance.resize(0, 0);
+  e.parameters.clear();
+  e.covariance_paper.resize(0, 0);
+  e.parameters_paper.clear();
+  e.interval_method.clear();
+  e.interval_method_id.clear();
+  e.derived.clear();
+  e.derived_method.clear();
+  e.singular_values.assign(r.s.data(), r.s.data() + r.s.size());
+  state_ = st;
+}
 
-  // The final Jacobian (covariance, rank) comes from the same exact sensitivities.
+const Estimate& FreeDecayRefinement::solved() const {
+  return state_->solved;
+}
+
+Estimate FreeDecayRefinement::finish() const {
+  const State& st = *state_;
+  const SlowRecord& record = *st.record;
+  const CeresOptions& options = st.options;
+  const ResonatorModel& model = st.model;
+  const int k = model.numParameters();
+  Eigen::VectorXd z = st.z;
+  Eigen::Vector4d q0 = st.q0;
+  // The per-sample problem: ceres::Covariance of a rank-deficient fit evaluates it.
+  ceres::Problem problem;
+  problem.AddResidualBlock(
+      makeFreeDecayOutputErrorCost(model, record, options.rk4_substeps,
+                                   TrajectoryDerivative::kSensitivity, st.z_scale, st.q0_scale)
+          .release(),
+      nullptr, z.data(), q0.data());
   FittedProblem fp;
   fp.problem = &problem;
   fp.blocks = {z.data(), q0.data()};
@@ -569,15 +732,32 @@ Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
   for (const char* n : {"q1_0", "p1_0", "q2_0", "p2_0"}) fp.all_names.push_back(n);
   fp.n_reported = k;
   fp.scale.resize(k + 4);
-  fp.scale << z_scale, Eigen::Vector4d::Constant(q0_scale);
+  fp.scale << st.z_scale, Eigen::Vector4d::Constant(st.q0_scale);
   fp.q = &record.q;
   fp.noise_correlation = noiseCorrelationFromMetadata(record.metadata);
+  // The per-sample rows (a noise model other than white needs them) from the same exact
+  // sensitivities.
   fp.evaluate_dense = [&](Eigen::MatrixXd* j, Eigen::VectorXd* r) {
     return evaluateFreeDecayOutputError(model, record, options.rk4_substeps,
-                                        z.cwiseProduct(z_scale), q0_scale * q0, j, r);
+                                        z.cwiseProduct(st.z_scale), st.q0_scale * q0, j, r);
   };
-  finishEstimate(fp, options, &e);
+  AtSolution a;
+  a.n = 4 * static_cast<long>(record.size());
+  a.p = k + 4;
+  a.cost = 0.5 * st.pass.ss;
+  a.scale = fp.scale;
+  a.x.resize(k + 4);
+  a.x << z, q0;
+  a.x = a.x.cwiseProduct(a.scale);
+  a.lag1 = a.n <= 8 || !(st.pass.ss > 0.0) ? 0.0 : st.pass.lag_one / st.pass.ss;
+  Estimate e = st.solved;
+  finishEstimate(fp, options, std::move(a), rankFromFactor(st.factor, options.rank_tolerance), &e);
   return e;
+}
+
+Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
+                         const CeresOptions& options) {
+  return FreeDecayRefinement(record, start, options).finish();
 }
 
 Estimate refineWithCeres(const SweepRecord& record, const Estimate& start,

@@ -45,6 +45,14 @@ CeresOptions refinementOptions(const PipelineOptions& o) {
   return c;
 }
 
+Estimate keptStart(const Estimate& start, const AnalysisError& err) {
+  Estimate kept = start;
+  kept.notes.push_back(std::string("output-error refinement failed, equation-error LS kept (its "
+                                   "xi-type terms carry an EIV bias): ") +
+                       err.what());
+  return kept;
+}
+
 template <class Record>
 Estimate refine(const Record& record, const Estimate& start, const PipelineOptions& o) {
   if (o.method != Method::kCeres) return start;
@@ -52,11 +60,7 @@ Estimate refine(const Record& record, const Estimate& start, const PipelineOptio
     return refineWithCeres(record, start, refinementOptions(o));
   } catch (const AnalysisError& err) {
     if (o.on_ceres_failure == CeresFailure::kThrow) throw;
-    Estimate kept = start;
-    kept.notes.push_back(std::string("output-error refinement failed, equation-error LS kept (its "
-                                     "xi-type terms carry an EIV bias): ") +
-                         err.what());
-    return kept;
+    return keptStart(start, err);
   }
 }
 
@@ -78,6 +82,25 @@ std::vector<std::string> PipelineOptions::validate() const {
 Estimate identify(const SlowRecord& record, const PipelineOptions& options) {
   throwIfInvalid("invalid identification options", options.validate());
   return refine(record, identifyFreeDecay(record, regressionOptions(options)), options);
+}
+
+DeferredEstimate identifyDeferred(const SlowRecord& record, const PipelineOptions& options) {
+  throwIfInvalid("invalid identification options", options.validate());
+  DeferredEstimate d;
+  const Estimate start = identifyFreeDecay(record, regressionOptions(options));
+  if (options.method != Method::kCeres) {
+    d.estimate = start;
+    return d;
+  }
+  try {
+    const FreeDecayRefinement refinement(record, start, refinementOptions(options));
+    d.estimate = refinement.solved();
+    d.finish = [refinement]() { return refinement.finish(); };
+  } catch (const AnalysisError& err) {
+    if (options.on_ceres_failure == CeresFailure::kThrow) throw;
+    d.estimate = keptStart(start, err);
+  }
+  return d;
 }
 
 Estimate identify(const SweepRecord& record, const PipelineOptions& options) {

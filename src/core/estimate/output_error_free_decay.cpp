@@ -152,12 +152,13 @@ class FreeDecaySensitivityCost : public ceres::CostFunction {
 class FreeDecaySquareRootCost : public ceres::CostFunction {
  public:
   FreeDecaySquareRootCost(const ResonatorModel& model, const SlowRecord& record, int substeps,
-                          const Eigen::VectorXd& z_scale, double q0_scale)
+                          const Eigen::VectorXd& z_scale, double q0_scale, SquareRootPass* last)
       : model_(model),
         record_(record),
         substeps_(substeps),
         z_scale_(z_scale.size() == 0 ? Eigen::VectorXd::Ones(model.numParameters()) : z_scale),
-        q0_scale_(q0_scale) {
+        q0_scale_(q0_scale),
+        last_(last) {
     set_num_residuals(model.numParameters() + 5);
     mutable_parameter_block_sizes()->push_back(model.numParameters());
     mutable_parameter_block_sizes()->push_back(4);
@@ -182,15 +183,29 @@ class FreeDecaySquareRootCost : public ceres::CostFunction {
     }
     IncrementalQr qr(m);
     RegressionBlockMatrix block(4, m);
+    Eigen::Vector4d previous = Eigen::Vector4d::Zero();
+    double ss = 0.0, lag_one = 0.0;
     const bool ok =
         integrateWithSensitivities(model_, z, q0, record_.t_s, substeps_,
                                    [&](size_t i, const Eigen::Vector4d& q, const Sensitivity& s) {
                                      block.leftCols(p) = s.leftCols(p) * z_scale_.asDiagonal();
                                      block.rightCols(4) = q0_scale_ * s.rightCols(4);
-                                     qr.addBlock(block, q - record_.q[i]);
+                                     const Eigen::Vector4d r = q - record_.q[i];
+                                     qr.addBlock(block, r);
+                                     ss += r.squaredNorm();
+                                     if (i > 0) lag_one += r.dot(previous);
+                                     previous = r;
                                    });
     if (!ok) return false;
     const Eigen::MatrixXd& r_aug = qr.rAug();
+    if (last_ != nullptr) {
+      last_->x.resize(m);
+      last_->x << Eigen::Map<const Eigen::VectorXd>(parameters[0], p),
+          Eigen::Map<const Eigen::Vector4d>(parameters[1]);
+      last_->r_aug = r_aug;
+      last_->ss = ss;
+      last_->lag_one = lag_one;
+    }
     out.head(m) = r_aug.col(m).head(m);
     out[m] = r_aug(m, m);
     if (jacobians[0] != nullptr) {
@@ -214,16 +229,16 @@ class FreeDecaySquareRootCost : public ceres::CostFunction {
   int substeps_;
   Eigen::VectorXd z_scale_;
   double q0_scale_;
+  SquareRootPass* last_;
 };
 
 }  // namespace
 
-std::unique_ptr<ceres::CostFunction> makeFreeDecaySquareRootCost(const ResonatorModel& model,
-                                                                 const SlowRecord& record,
-                                                                 int substeps,
-                                                                 const Eigen::VectorXd& z_scale,
-                                                                 double q0_scale) {
-  return std::make_unique<FreeDecaySquareRootCost>(model, record, substeps, z_scale, q0_scale);
+std::unique_ptr<ceres::CostFunction> makeFreeDecaySquareRootCost(
+    const ResonatorModel& model, const SlowRecord& record, int substeps,
+    const Eigen::VectorXd& z_scale, double q0_scale, SquareRootPass* last_pass) {
+  return std::make_unique<FreeDecaySquareRootCost>(model, record, substeps, z_scale, q0_scale,
+                                                   last_pass);
 }
 
 bool evaluateFreeDecayOutputError(const ResonatorModel& model, const SlowRecord& record,

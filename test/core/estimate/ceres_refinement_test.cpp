@@ -143,6 +143,34 @@ TEST(CeresRefinement, NoisyFreeDecayTruthInsideIntervals) {
   EXPECT_FALSE(e.derived.empty());
 }
 
+// A long record is first fitted on every s-th sample (CeresOptions::coarse_samples); the fit on
+// the whole record continues from there, so it must reach the whole record's optimum: the same
+// values (to 1e-3 of a standard error) and sigma as without the coarse start.
+TEST(CeresRefinement, CoarseStartReachesTheWholeRecordOptimum) {
+  const ResonatorModel model("xi", ExperimentMode::kFreeDecay);
+  SlowRecord record;
+  record.omega_rad_s = 30000.0;
+  for (int i = 0; i <= 4000; ++i) record.t_s.push_back(0.001 * i);
+  ASSERT_TRUE(integrateSlowTrajectory(model, model.parameterVector(kFreeTruth), kQ0, record.t_s, 4,
+                                      &record.q));
+  addNoise(&record.q, 2e-3, 11);
+  const Estimate start = startEstimate("xi", ExperimentMode::kFreeDecay, kFreeTruth, 0.05);
+  CeresOptions whole, coarse;
+  whole.coarse_samples = 0;
+  coarse.coarse_samples = 500;
+  const Estimate a = refineWithCeres(record, start, whole);
+  const Estimate b = refineWithCeres(record, start, coarse);
+  bool noted = false;
+  for (const auto& n : b.notes) noted = noted || n.find("every 8th sample") != std::string::npos;
+  EXPECT_TRUE(noted);
+  for (const auto& name : a.names) {
+    const ParameterEstimate& pa = a.parameters.at(name);
+    EXPECT_NEAR(b.parameters.at(name).value, pa.value, 1e-3 * pa.std_error) << name;
+    EXPECT_NEAR(b.parameters.at(name).std_error, pa.std_error, 1e-6 * pa.std_error) << name;
+  }
+  EXPECT_NEAR(b.sigma, a.sigma, 1e-9 * a.sigma);
+}
+
 // Slow samples with filtered noise (a 3-tap moving average: rho_1 = 2/3, rho_2 = 1/3, long-run
 // variance 3x the white formula's) whose record states that correlation, as a demodulated record
 // does (demodulator_noise.h): the intervals must cover the truth. With the white-noise formula

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "cvg_bench/core/model/errors.h"
@@ -80,6 +81,36 @@ TEST(IdentifyPipeline, EveryMethodRecoversNoiselessFreeDecay) {
     EXPECT_NEAR(rls.parameters.at(kv.first).value, ls.parameters.at(kv.first).value, 1e-8)
         << kv.first;
   expectTruth(ceres, kFreeDecayTruth, 1e-6);
+}
+
+// The deferred form (explain's refined fits): the solved estimate already has identify()'s
+// values, sigma and dof but no intervals; finish() returns identify()'s estimate.
+TEST(IdentifyPipeline, DeferredCeresFinishesToTheSameEstimate) {
+  SlowRecord record = freeDecay();
+  for (size_t i = 0; i < record.size(); ++i)
+    record.q[i] += 1e-3 * Eigen::Vector4d(std::sin(7.1 * i), std::cos(3.3 * i), std::sin(1.9 * i),
+                                          std::cos(5.7 * i));
+  const PipelineOptions o = optionsFor("xi", Method::kCeres);
+  const Estimate full = identify(record, o);
+  const DeferredEstimate d = identifyDeferred(record, o);
+  ASSERT_TRUE(static_cast<bool>(d.finish));
+  EXPECT_EQ(d.estimate.method, "ceres");
+  EXPECT_TRUE(d.estimate.parameters.empty());
+  EXPECT_EQ(d.estimate.dof, full.dof);
+  EXPECT_DOUBLE_EQ(d.estimate.sigma, full.sigma);
+  const Estimate finished = d.finish();
+  EXPECT_EQ(finished.notes, full.notes);
+  EXPECT_EQ(finished.interval_method_id, full.interval_method_id);
+  for (const auto& kv : full.parameters) {
+    EXPECT_DOUBLE_EQ(
+        d.estimate.values[std::find(d.estimate.names.begin(), d.estimate.names.end(), kv.first) -
+                          d.estimate.names.begin()],
+        kv.second.value)
+        << kv.first;
+    EXPECT_DOUBLE_EQ(finished.parameters.at(kv.first).value, kv.second.value) << kv.first;
+    EXPECT_DOUBLE_EQ(finished.parameters.at(kv.first).std_error, kv.second.std_error) << kv.first;
+  }
+  EXPECT_FALSE(identifyDeferred(record, optionsFor("xi", Method::kLs)).finish);
 }
 
 TEST(IdentifyPipeline, CeresEstimatesMuJointlyFromLsStart) {

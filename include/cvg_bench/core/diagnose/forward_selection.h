@@ -18,6 +18,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,9 @@ struct NestedFit {
   /// The linear part's z of that scoring fit, when it differs from the estimate's (forced: the
   /// output-error GLS; the adequacy residuals are taken there).
   Eigen::VectorXd scored_values;
+  /// Set when the estimate's covariance and intervals were deferred (a refined fit that may only
+  /// be ranked): returns the complete estimate (the same sigma, rss and values).
+  std::function<Estimate()> finish;
 };
 
 /// Mode-specific fitting through the identification API (nested_model_fitters.h).

@@ -1,8 +1,8 @@
 // Output-error refinement of an equation-error (LS) estimate with Ceres (`--method ceres`).
 //
 // The equation-error LS of (2.7)-(2.9) / (3.4)-(3.5) puts the noisy measured q inside the regressor
-// D(q), which biases it (errors in variables, docs/paper.md item 15) and correlates its equation errors
-// (item 10). The output-error fit removes both by comparing measured q with the MODEL's q:
+// D(q), which biases it (errors in variables, docs/paper.md item 15) and correlates its equation
+// errors (item 10). The output-error fit removes both by comparing measured q with the MODEL's q:
 //  - free decay: q_model(t_i) integrates the averaged equations (2.6), 2 q' = D(q) z, by RK4 on the
 //    record's time grid from fitted initial slow variables q(t_0) (4 nuisance unknowns);
 //  - forced sweep: q_model(omega0_j) is the stationary point of (3.3), 0 = D(q) z - rate_j y(q),
@@ -13,6 +13,7 @@
 // sigma^2 = 2 cost / (n - rank); Student-t intervals as in (2.11). sigma is in units of q.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,11 @@ struct CeresOptions {
   /// Free decay: RK4 steps per interval of the record's time grid, 1..1000 (raise it when the
   /// record is sampled coarsely relative to the slow rates).
   int rk4_substeps = 1;
+  /// Free decay: a record of at least 4x this many samples is first fitted on every s-th sample
+  /// (s ~ record size / coarse_samples, capped so that RK4 on the coarser grid stays accurate), a
+  /// cheap start; the fit on the whole record continues from there with the tolerances above, so
+  /// the answer is the whole record's optimum either way. 0 = never.
+  int coarse_samples = 20000;
   /// Known control nonlinearity mu [1/amplitude^2] used when the model spec has no `mu`; forced
   /// mode only (free decay has no drive).
   double known_mu = 0.0;
@@ -69,6 +75,23 @@ struct CeresOptions {
 /// matching its model, invalid options); AnalysisError when Ceres finds no usable solution.
 Estimate refineWithCeres(const SlowRecord& record, const Estimate& start,
                          const CeresOptions& options = CeresOptions());
+
+/// The same in two steps: the constructor solves (errors as above); solved() has the values,
+/// sigma, rank, dof and notes of the solve but no covariance or intervals (enough to rank a
+/// model or to predict with it); finish() adds the covariance, intervals, identifiability and
+/// derived quantities and returns what refineWithCeres returns. The record must outlive the
+/// object and its copies (they share the solved state).
+class FreeDecayRefinement {
+ public:
+  FreeDecayRefinement(const SlowRecord& record, const Estimate& start,
+                      const CeresOptions& options = CeresOptions());
+  const Estimate& solved() const;
+  Estimate finish() const;
+
+ private:
+  struct State;
+  std::shared_ptr<const State> state_;
+};
 
 /// Output-error refinement of a forced-sweep estimate (stationary points of (3.3)); omega from
 /// start.omega_rad_s, else record.omega_rad_s (InputError when neither is > 0). Estimates mu

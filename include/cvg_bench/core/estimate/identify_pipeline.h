@@ -12,6 +12,7 @@
 // estimate z and mu jointly; any other method is an InputError naming the way out.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,16 @@ struct PipelineOptions {
 /// Free-decay identification of one record. InputError for bad input or options; AnalysisError
 /// when Ceres finds no usable solution and on_ceres_failure is kThrow.
 Estimate identify(const SlowRecord& record, const PipelineOptions& options);
+/// The same with the free-decay refinement's covariance deferred (explain ranks many refined fits
+/// and reports few): `estimate` is FreeDecayRefinement::solved() (values, sigma, rank, dof; no
+/// intervals) and `finish` returns what identify() returns; with another method, or when the
+/// refinement failed and on_ceres_failure keeps the start, `estimate` is identify()'s answer and
+/// `finish` is empty. The record must outlive `finish`.
+struct DeferredEstimate {
+  Estimate estimate;
+  std::function<Estimate()> finish;
+};
+DeferredEstimate identifyDeferred(const SlowRecord& record, const PipelineOptions& options);
 /// Forced-sweep identification of one sweep record; errors as above.
 Estimate identify(const SweepRecord& record, const PipelineOptions& options);
 

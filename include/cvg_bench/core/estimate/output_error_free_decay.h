@@ -86,9 +86,24 @@ std::unique_ptr<ceres::CostFunction> makeFreeDecayOutputErrorCost(
 /// the factor [R c; 0 rho] of [J | r] folded sample by sample; LM sees the same cost, gradient and
 /// Gauss-Newton matrix as with makeFreeDecayOutputErrorCost(kSensitivity). Not for the covariance
 /// or the residual tests (they need the per-sample rows: evaluateFreeDecayOutputError).
+/// last_pass (optional) receives what each evaluation with Jacobians saw (SquareRootPass).
+struct SquareRootPass;
 std::unique_ptr<ceres::CostFunction> makeFreeDecaySquareRootCost(
     const ResonatorModel& model, const SlowRecord& record, int substeps,
-    const Eigen::VectorXd& z_scale = Eigen::VectorXd(), double q0_scale = 1.0);
+    const Eigen::VectorXd& z_scale = Eigen::VectorXd(), double q0_scale = 1.0,
+    SquareRootPass* last_pass = nullptr);
+
+/// The square-root cost's pass over the record with Jacobians: the unknowns it was made at (the
+/// scaled blocks x_z, x_q stacked), the factor [R c; 0 rho] of [J | r] (J of the scaled blocks),
+/// the residual sum of squares and the lag-one sum r_1.r_0 + r_2.r_1 + ... of the per-sample
+/// residual 4-vectors: what the rank, the white-noise covariance and the residuals' lag-1 test
+/// need, without the per-sample rows.
+struct SquareRootPass {
+  Eigen::VectorXd x;
+  Eigen::MatrixXd r_aug;
+  double ss = 0.0;
+  double lag_one = 0.0;
+};
 
 /// Residuals r_i = q_model(t_i) - q_measured(t_i) (4 (N + 1)) and their Jacobian with respect to
 /// the unscaled unknowns (z, q(t_0)), 4 (N + 1) x (numParameters() + 4), by forward sensitivities,
