@@ -394,7 +394,9 @@ class ForcedFitter : public NestedModelFitter {
 
   /// Output-error residuals to first order, r_j = A_j^{-1} F(q_j) (sweep_noise_model.h): the
   /// equation residual's scale grows with the detuning; r is in amplitude units at every point.
-  /// Points at a fold of the response (A_j singular) are left out.
+  /// Points at a fold of the response (A_j singular) are left out. Radial and tangential parts are
+  /// taken along the model's point q_j - r_j: along the measured q_j the radial part of the noise
+  /// has the mean 3 sigma^2 / |q_j|, large on the quiet wings, and made sign runs there.
   std::vector<BlockResidual> adequacyResiduals(const NestedFit& fit) const override {
     return linearize(fit).blocks;
   }
@@ -434,7 +436,7 @@ class ForcedFitter : public NestedModelFitter {
       r.segment<4>(4 * k++) = dq;
       out.index.push_back(j);
       out.a.push_back(a);
-      q.push_back(record_.q[j]);
+      q.push_back(record_.q[j] - dq);  // the model's point q_j - r_j, see adequacyResiduals
       abscissa.push_back(record_.omega0_rad_s[j]);
       lambda.push_back(record_.omega0_rad_s[j] - omega_);
     }
