@@ -153,6 +153,12 @@ class SubsetSearch {
     runTasks(todo.size(), options_.threads, [&](size_t i) {
       try {
         fits[i] = near ? fitter_.fitNear(todo[i], *near) : fitter_.fit(todo[i]);
+        // The linear model is always reported (the baseline): its intervals made here, on the
+        // batch's threads.
+        if (todo[i].empty() && fits[i].finish) {
+          fits[i].estimate = fits[i].finish();
+          fits[i].finish = nullptr;
+        }
       } catch (...) {
         errors[i] = std::current_exception();
       }
