@@ -249,7 +249,9 @@ Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
     // The structured test: a smooth component the (known + fitted) noise model cannot make.
     const ResidualNoiseModel known_model =
         known.empty() ? ResidualNoiseModel() : noiseModelFromCorrelation(known);
-    const LowFrequencyMisfitTest lf = lowFrequencyMisfit(adequacy, known_model);
+    LowFrequencyOptions lf_options;
+    lf_options.threads = options.selection.threads;
+    const LowFrequencyMisfitTest lf = lowFrequencyMisfit(adequacy, known_model, lf_options);
     lof.low_frequency_p_value = lf.p_value;
     lof.low_frequency = lf.worst;
     lof.test += "; " + lf.description + "; Bonferroni over the two tests";

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cvg_bench/core/diagnose/model_diagnosis.h"
+#include "cvg_bench/core/diagnose/parallel_tasks.h"
 #include "cvg_bench/core/estimate/fitted_residual_ar1.h"
 #include "cvg_bench/core/estimate/least_squares_solver.h"
 
@@ -147,11 +148,19 @@ LowFrequencyMisfitTest lowFrequencyMisfit(const std::vector<BlockResidual>& bloc
     seq[1].push_back(b.tangential);
     for (int c = 0; c < 4; ++c) seq[2 + c].push_back(b.e[c]);
   }
+  // The sequences are independent: tested several at a time, combined in their order.
+  double ps[6], rhos[6];
+  bool cappeds[6];
+  runTasks(6, options.threads, [&](size_t s) {
+    rhos[s] = 0.0;
+    cappeds[s] = false;
+    ps[s] = lowFrequencyPValue(seq[s], t, known, options, &rhos[s], &cappeds[s]);
+  });
   double best = 1.0;
   for (int s = 0; s < 6; ++s) {
-    double rho = 0.0;
-    bool capped = false;
-    const double p = lowFrequencyPValue(seq[s], t, known, options, &rho, &capped);
+    const double rho = rhos[s];
+    const bool capped = cappeds[s];
+    const double p = ps[s];
     r.rho_max = std::max(r.rho_max, rho);
     r.rho_capped = r.rho_capped || capped;
     if (p < best || r.worst.empty()) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/diagnose/candidate_extensions.h"
@@ -157,6 +158,14 @@ class FreeDecayFitter : public NestedModelFitter {
   NestedFit fit(const std::vector<std::string>& extensions) const override {
     return fitOn(record_, extensions);
   }
+  NestedFit fitNear(const std::vector<std::string>& extensions,
+                    const NestedFit& near) const override {
+    if (near.estimate.method != methodName(Method::kCeres)) return fit(extensions);
+    std::map<std::string, double> start;
+    for (size_t i = 0; i < near.estimate.names.size(); ++i)
+      start[near.estimate.names[i]] = near.estimate.values[i];
+    return fitOn(record_, extensions, start);
+  }
 
   /// Every subset is solved from the triangular factor of the widest system seen so far (one
   /// pass over the record per widening, see EquationErrorFactor); the per-equation residuals are
@@ -292,7 +301,8 @@ class FreeDecayFitter : public NestedModelFitter {
   /// output-error residuals are the measurement noise itself, so the Wald test on its covariance is
   /// honest. The equation residuals (for the signature) are those of (2.8) at the refined z; a
   /// refined fit does not keep them (4 doubles a sample each): blocks() makes them when asked.
-  NestedFit fitOn(const SlowRecord& record, const std::vector<std::string>& extensions) const {
+  NestedFit fitOn(const SlowRecord& record, const std::vector<std::string>& extensions,
+                  const std::map<std::string, double>& ceres_start = {}) const {
     PipelineOptions p;
     p.method = Method::kCeres;
     p.identification = options_.identification;
@@ -301,6 +311,7 @@ class FreeDecayFitter : public NestedModelFitter {
     p.ceres.rk4_substeps = options_.rk4_substeps;
     // A failed refinement keeps the LS answer (honest sandwich intervals) and says why.
     p.on_ceres_failure = CeresFailure::kKeepStart;
+    p.ceres_start = ceres_start;
     NestedFit f;
     f.extensions = extensions;
     // Covariance deferred: most refined fits are only ranked (NestedFit::finish).

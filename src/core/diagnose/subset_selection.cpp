@@ -138,7 +138,8 @@ class SubsetSearch {
 
   /// Refines every subset of `batch` not refined yet, several at a time (options.threads); the
   /// cache and the notes end as if refined() had been called on each in batch order.
-  void refineAll(const std::vector<Terms>& batch) {
+  /// `near` (optional): a refined fit nested in every subset of the batch, their start.
+  void refineAll(const std::vector<Terms>& batch, const NestedFit* near = nullptr) {
     // Without an output-error stage refined() is the cheap fit, which extends a shared factor.
     if (!fitter_.refinesByOutputError()) return;
     std::vector<Terms> todo;
@@ -151,7 +152,13 @@ class SubsetSearch {
     std::vector<std::exception_ptr> errors(todo.size());
     runTasks(todo.size(), options_.threads, [&](size_t i) {
       try {
-        fits[i] = fitter_.fit(todo[i]);
+        fits[i] = near ? fitter_.fitNear(todo[i], *near) : fitter_.fit(todo[i]);
+        // The linear model is always reported (the baseline): its intervals made here, on the
+        // batch's threads.
+        if (todo[i].empty() && fits[i].finish) {
+          fits[i].estimate = fits[i].finish();
+          fits[i].finish = nullptr;
+        }
       } catch (...) {
         errors[i] = std::current_exception();
       }
@@ -397,7 +404,7 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
       if (static_cast<int>(t.size()) > options.max_steps || crit.count(key(t))) continue;
       extensions.push_back(t);
     }
-    search.refineAll(extensions);
+    search.refineAll(extensions, fitOf(best));  // started from the best subset's refined fit
     for (const auto& t : extensions)
       if (score(t) < best_v) improved = true;
     if (!improved) break;

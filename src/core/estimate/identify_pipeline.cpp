@@ -1,5 +1,6 @@
 #include "cvg_bench/core/estimate/identify_pipeline.h"
 
+#include <cmath>
 #include <sstream>
 
 #include "cvg_bench/core/model/errors.h"
@@ -92,8 +93,17 @@ DeferredEstimate identifyDeferred(const SlowRecord& record, const PipelineOption
     d.estimate = start;
     return d;
   }
+  Estimate near = start;
+  CeresOptions refinement_options = refinementOptions(options);
+  if (!options.ceres_start.empty()) {
+    for (size_t i = 0; i < near.names.size(); ++i) {
+      const auto it = options.ceres_start.find(near.names[i]);
+      if (it != options.ceres_start.end() && std::isfinite(it->second)) near.values[i] = it->second;
+    }
+    refinement_options.coarse_samples = 0;
+  }
   try {
-    const FreeDecayRefinement refinement(record, start, refinementOptions(options));
+    const FreeDecayRefinement refinement(record, near, refinement_options);
     d.estimate = refinement.solved();
     d.finish = [refinement]() { return refinement.finish(); };
   } catch (const AnalysisError& err) {

@@ -172,42 +172,41 @@ class FreeDecaySquareRootCost : public ceres::CostFunction {
         z_scale_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(parameters[0], p));
     const Eigen::Vector4d q0 = q0_scale_ * Eigen::Map<const Eigen::Vector4d>(parameters[1]);
     Eigen::Map<Eigen::VectorXd> out(residuals, m + 1);
-    out.setZero();
-    if (jacobians == nullptr || (jacobians[0] == nullptr && jacobians[1] == nullptr)) {
-      double ss = 0.0;
-      const bool ok = forEachTrajectoryPoint(
-          model_, z, q0, record_.t_s, substeps_,
-          [&](size_t i, const Eigen::Vector4d& q) { ss += (q - record_.q[i]).squaredNorm(); });
-      out[m] = std::sqrt(ss);
-      return ok && std::isfinite(ss);
+    // Every evaluation makes the factor (a cost-only pass would cost ~1/3 of it), kept for the
+    // unknowns it was made at: Levenberg-Marquardt asks for the Jacobian of an accepted trial
+    // point right after its cost, and gets it without a second pass.
+    Eigen::VectorXd x(m);
+    x << Eigen::Map<const Eigen::VectorXd>(parameters[0], p),
+        Eigen::Map<const Eigen::Vector4d>(parameters[1]);
+    if (cache_.x.size() != m || cache_.x != x) {
+      cache_.x.resize(0);
+      IncrementalQr qr(m);
+      RegressionBlockMatrix block(4, m);
+      Eigen::Vector4d previous = Eigen::Vector4d::Zero();
+      double ss = 0.0, lag_one = 0.0;
+      const bool ok =
+          integrateWithSensitivities(model_, z, q0, record_.t_s, substeps_,
+                                     [&](size_t i, const Eigen::Vector4d& q, const Sensitivity& s) {
+                                       block.leftCols(p) = s.leftCols(p) * z_scale_.asDiagonal();
+                                       block.rightCols(4) = q0_scale_ * s.rightCols(4);
+                                       const Eigen::Vector4d r = q - record_.q[i];
+                                       qr.addBlock(block, r);
+                                       ss += r.squaredNorm();
+                                       if (i > 0) lag_one += r.dot(previous);
+                                       previous = r;
+                                     });
+      if (!ok) return false;
+      cache_.r_aug = qr.rAug();
+      cache_.ss = ss;
+      cache_.lag_one = lag_one;
+      cache_.x = x;
     }
-    IncrementalQr qr(m);
-    RegressionBlockMatrix block(4, m);
-    Eigen::Vector4d previous = Eigen::Vector4d::Zero();
-    double ss = 0.0, lag_one = 0.0;
-    const bool ok =
-        integrateWithSensitivities(model_, z, q0, record_.t_s, substeps_,
-                                   [&](size_t i, const Eigen::Vector4d& q, const Sensitivity& s) {
-                                     block.leftCols(p) = s.leftCols(p) * z_scale_.asDiagonal();
-                                     block.rightCols(4) = q0_scale_ * s.rightCols(4);
-                                     const Eigen::Vector4d r = q - record_.q[i];
-                                     qr.addBlock(block, r);
-                                     ss += r.squaredNorm();
-                                     if (i > 0) lag_one += r.dot(previous);
-                                     previous = r;
-                                   });
-    if (!ok) return false;
-    const Eigen::MatrixXd& r_aug = qr.rAug();
-    if (last_ != nullptr) {
-      last_->x.resize(m);
-      last_->x << Eigen::Map<const Eigen::VectorXd>(parameters[0], p),
-          Eigen::Map<const Eigen::Vector4d>(parameters[1]);
-      last_->r_aug = r_aug;
-      last_->ss = ss;
-      last_->lag_one = lag_one;
-    }
+    const Eigen::MatrixXd& r_aug = cache_.r_aug;
     out.head(m) = r_aug.col(m).head(m);
     out[m] = r_aug(m, m);
+    if (jacobians == nullptr || (jacobians[0] == nullptr && jacobians[1] == nullptr))
+      return out.allFinite();
+    if (last_ != nullptr) *last_ = cache_;
     if (jacobians[0] != nullptr) {
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> jz(
           jacobians[0], m + 1, p);
@@ -230,6 +229,7 @@ class FreeDecaySquareRootCost : public ceres::CostFunction {
   Eigen::VectorXd z_scale_;
   double q0_scale_;
   SquareRootPass* last_;
+  mutable SquareRootPass cache_;  ///< the last pass (one solve evaluates from one thread)
 };
 
 }  // namespace

@@ -55,6 +55,13 @@ class NestedModelFitter {
   virtual ~NestedModelFitter() = default;
   /// The linear base plus these extensions, fitted to all the data.
   virtual NestedFit fit(const std::vector<std::string>& extensions) const = 0;
+  /// fit() started near `near`, a refined fit of a nested model (its values where the models
+  /// share parameters): the same optimum, found in fewer iterations. Default: fit().
+  virtual NestedFit fitNear(const std::vector<std::string>& extensions,
+                            const NestedFit& near) const {
+    (void)near;
+    return fit(extensions);
+  }
   /// The cheap fit used to rank subsets: equation-error LS (free decay), the same as fit() where
   /// there is nothing cheaper (forced sweeps).
   virtual NestedFit fitEquationError(const std::vector<std::string>& extensions) const {

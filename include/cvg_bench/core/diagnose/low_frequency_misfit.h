@@ -38,6 +38,7 @@ struct LowFrequencyMisfitTest {
 struct LowFrequencyOptions {
   int degree = 5;             ///< K: Legendre degree of the smooth basis, 1..12
   double rho_ceiling = 0.95;  ///< cap of the fitted AR(1) coefficient, in (0, 1)
+  int threads = 1;            ///< the 6 sequences tested this many at a time (0 = all cores)
 };
 
 /// The test of one sequence; p-value in [0, 1] (1 when too short: n < 4 (K + 1)).

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,10 @@ struct PipelineOptions {
   /// known_mu and mu_start are taken from `identification`, so the two stages agree.
   CeresOptions ceres;
   CeresFailure on_ceres_failure = CeresFailure::kThrow;
+  /// Free decay, kCeres: values that replace the LS answer's in the refinement's start (e.g. a
+  /// nested model's refined fit: explain's one-term extensions), the other parameters keeping
+  /// their LS values; the start is then near the optimum and the coarse start is skipped.
+  std::map<std::string, double> ceres_start;
 
   /// Every problem with the options (of both stages), empty when valid.
   std::vector<std::string> validate() const;
