@@ -164,7 +164,11 @@ class FreeDecayFitter : public NestedModelFitter {
     std::map<std::string, double> start;
     for (size_t i = 0; i < near.estimate.names.size(); ++i)
       start[near.estimate.names[i]] = near.estimate.values[i];
-    return fitOn(record_, extensions, start);
+    // The added terms start at zero, where the wider model is the nearer one at its optimum
+    // (their LS values, biased by the noise in D(q), start far from it).
+    const ResonatorModel wider(extensions, ExperimentMode::kFreeDecay);
+    for (const auto& name : wider.parameterNames()) start.emplace(name, 0.0);
+    return fitOn(record_, extensions, start, near.estimate.initial_slow_state);
   }
 
   /// Every subset is solved from the triangular factor of the widest system seen so far (one
@@ -302,7 +306,8 @@ class FreeDecayFitter : public NestedModelFitter {
   /// honest. The equation residuals (for the signature) are those of (2.8) at the refined z; a
   /// refined fit does not keep them (4 doubles a sample each): blocks() makes them when asked.
   NestedFit fitOn(const SlowRecord& record, const std::vector<std::string>& extensions,
-                  const std::map<std::string, double>& ceres_start = {}) const {
+                  const std::map<std::string, double>& ceres_start = {},
+                  const Eigen::VectorXd& ceres_start_state = Eigen::VectorXd()) const {
     PipelineOptions p;
     p.method = Method::kCeres;
     p.identification = options_.identification;
@@ -312,6 +317,7 @@ class FreeDecayFitter : public NestedModelFitter {
     // A failed refinement keeps the LS answer (honest sandwich intervals) and says why.
     p.on_ceres_failure = CeresFailure::kKeepStart;
     p.ceres_start = ceres_start;
+    p.ceres_start_state = ceres_start_state;
     NestedFit f;
     f.extensions = extensions;
     // Covariance deferred: most refined fits are only ranked (NestedFit::finish).

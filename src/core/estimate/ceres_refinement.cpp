@@ -29,6 +29,9 @@ std::vector<std::string> CeresOptions::validate() const {
   if (!(confidence > 0 && confidence < 1)) p.push_back("confidence must be in (0, 1)");
   if (max_iterations < 1) p.push_back("max_iterations must be >= 1");
   if (!(function_tolerance > 0)) p.push_back("function_tolerance must be > 0");
+  if (!(likelihood_tolerance >= 0)) p.push_back("likelihood_tolerance must be >= 0");
+  if (likelihood_tolerance_min_samples < 0)
+    p.push_back("likelihood_tolerance_min_samples must be >= 0");
   if (!(parameter_tolerance > 0)) p.push_back("parameter_tolerance must be > 0");
   if (!(gradient_tolerance > 0)) p.push_back("gradient_tolerance must be > 0");
   if (rk4_substeps < 1 || rk4_substeps > 1000) p.push_back("rk4_substeps must be in 1..1000");
@@ -102,12 +105,17 @@ struct FittedProblem {
   std::function<bool(Eigen::MatrixXd*, Eigen::VectorXd*)> evaluate_dense;
 };
 
-void solveOrThrow(ceres::Problem* problem, const CeresOptions& options,
+/// n_residuals: the scalar residuals behind the cost (4 a sample or sweep point), which scale
+/// CeresOptions::likelihood_tolerance to Ceres's relative function tolerance.
+void solveOrThrow(ceres::Problem* problem, const CeresOptions& options, long n_residuals,
                   ceres::Solver::Summary* summary) {
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
   so.max_num_iterations = options.max_iterations;
   so.function_tolerance = options.function_tolerance;
+  if (n_residuals >= 4 * options.likelihood_tolerance_min_samples)
+    so.function_tolerance = std::max(
+        so.function_tolerance, options.likelihood_tolerance / static_cast<double>(n_residuals));
   so.parameter_tolerance = options.parameter_tolerance;
   so.gradient_tolerance = options.gradient_tolerance;
   so.logging_type = ceres::SILENT;
@@ -612,7 +620,11 @@ FreeDecayRefinement::FreeDecayRefinement(const SlowRecord& record, const Estimat
   Eigen::VectorXd& z = st->z;
   Eigen::Vector4d& q0 = st->q0;
   z = z_start.cwiseQuotient(z_scale);
-  q0 = record.q.front() / q0_scale;
+  // q(t0): the start's fitted one where it has one (a nested model's refined fit), else the
+  // first measured sample.
+  const bool start_has_state =
+      start.initial_slow_state.size() == 4 && start.initial_slow_state.allFinite();
+  q0 = (start_has_state ? Eigen::Vector4d(start.initial_slow_state) : record.q.front()) / q0_scale;
   // A long record: the same problem on every s-th sample first (a start near the optimum costs
   // the whole record a few iterations instead of tens).
   std::string coarse_note;
@@ -628,7 +640,7 @@ FreeDecayRefinement::FreeDecayRefinement(const SlowRecord& record, const Estimat
         nullptr, zc.data(), qc.data());
     ceres::Solver::Summary coarse_summary;
     try {
-      solveOrThrow(&coarse_problem, options, &coarse_summary);
+      solveOrThrow(&coarse_problem, options, 4 * static_cast<long>(coarse.size()), &coarse_summary);
       z = zc;
       q0 = qc;
       coarse_note = "start from the same fit on every " + std::to_string(stride) + "th sample (" +
@@ -648,7 +660,7 @@ FreeDecayRefinement::FreeDecayRefinement(const SlowRecord& record, const Estimat
   ceres::CostFunction* cost_ptr = cost.get();
   square_root.AddResidualBlock(cost.release(), nullptr, z.data(), q0.data());
   ceres::Solver::Summary summary;
-  solveOrThrow(&square_root, options, &summary);
+  solveOrThrow(&square_root, options, 4 * static_cast<long>(record.size()), &summary);
   Eigen::VectorXd x(k + 4);
   x << z, q0;
   if (st->pass.x.size() != x.size() || st->pass.x != x) {
@@ -678,6 +690,7 @@ FreeDecayRefinement::FreeDecayRefinement(const SlowRecord& record, const Estimat
       std::to_string(options.rk4_substeps) +
       " step(s) per sample interval), Jacobian by forward sensitivities");
   const Eigen::Vector4d q0_fitted = q0_scale * q0;
+  e.initial_slow_state = q0_fitted;
   e.notes.push_back("fitted initial slow variables q(t0) = " + formatQ(q0_fitted.data()) +
                     " (4 nuisance unknowns, not in parameters)");
   e.notes.push_back(kSigmaNote);
@@ -815,7 +828,7 @@ Estimate refineWithCeres(const SweepRecord& record, const Estimate& start,
     throw InputError(where + ": " + std::to_string(used_q.size()) + " usable points: too few for " +
                      std::to_string(n_unknowns) + " unknowns");
   ceres::Solver::Summary summary;
-  solveOrThrow(&problem, options, &summary);
+  solveOrThrow(&problem, options, 4 * static_cast<long>(used_q.size()), &summary);
 
   Estimate e = start;
   e.mode = ExperimentMode::kForced;

@@ -100,6 +100,7 @@ DeferredEstimate identifyDeferred(const SlowRecord& record, const PipelineOption
       const auto it = options.ceres_start.find(near.names[i]);
       if (it != options.ceres_start.end() && std::isfinite(it->second)) near.values[i] = it->second;
     }
+    near.initial_slow_state = options.ceres_start_state;
     refinement_options.coarse_samples = 0;
   }
   try {

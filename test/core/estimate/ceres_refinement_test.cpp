@@ -171,6 +171,88 @@ TEST(CeresRefinement, CoarseStartReachesTheWholeRecordOptimum) {
   EXPECT_NEAR(b.sigma, a.sigma, 1e-9 * a.sigma);
 }
 
+/// The last solver note "Ceres <termination> after N iterations, cost C0 -> C1" (a refinement
+/// of a refined estimate keeps the earlier notes).
+std::string solverNote(const Estimate& e) {
+  for (auto it = e.notes.rbegin(); it != e.notes.rend(); ++it)
+    if (it->rfind("Ceres ", 0) == 0 && it->find(" after ") != std::string::npos) return *it;
+  return "";
+}
+double initialCost(const Estimate& e) {
+  const std::string n = solverNote(e);
+  const auto at = n.find("cost ");
+  return at == std::string::npos ? -1.0 : std::stod(n.substr(at + 5));
+}
+double finalCost(const Estimate& e) {
+  const std::string n = solverNote(e);
+  const auto at = n.find("-> ");
+  return at == std::string::npos ? -1.0 : std::stod(n.substr(at + 3));
+}
+
+int solverIterations(const Estimate& e) {
+  const std::string n = solverNote(e);
+  const auto at = n.find(" after ");
+  return at == std::string::npos ? -1 : std::stoi(n.substr(at + 7));
+}
+
+SlowRecord longXiRecord(unsigned seed) {
+  const ResonatorModel model("xi", ExperimentMode::kFreeDecay);
+  SlowRecord record;
+  record.omega_rad_s = 30000.0;
+  for (int i = 0; i <= 4000; ++i) record.t_s.push_back(0.001 * i);
+  EXPECT_TRUE(integrateSlowTrajectory(model, model.parameterVector(kFreeTruth), kQ0, record.t_s, 4,
+                                      &record.q));
+  addNoise(&record.q, 2e-3, seed);
+  return record;
+}
+
+// The likelihood tolerance (long records) stops a misfit model's slow crawl along its valley:
+// fewer passes, the criterion n ln RSS within 1e-3 of the tight optimum and the values within a
+// few hundredths of their standard errors (CeresOptions::likelihood_tolerance).
+TEST(CeresRefinement, LikelihoodToleranceStopsNearTheOptimumInFewerPasses) {
+  const SlowRecord record = longXiRecord(12);
+  const Estimate start = startEstimate("linear", ExperimentMode::kFreeDecay, kFreeTruth, 0.05);
+  CeresOptions tight, loose;
+  tight.coarse_samples = loose.coarse_samples = 0;
+  tight.likelihood_tolerance_min_samples = 1000000;  // off for this record
+  loose.likelihood_tolerance_min_samples = 0;
+  const Estimate a = refineWithCeres(record, start, tight);
+  const Estimate b = refineWithCeres(record, start, loose);
+  ASSERT_GT(a.sigma, 1.1 * 2e-3);  // the model misfits: xi is left out
+  EXPECT_LT(solverIterations(b), solverIterations(a)) << solverNote(a) << " / " << solverNote(b);
+  const double n = static_cast<double>(a.n_equations);
+  EXPECT_LT(n * std::log((b.sigma * b.sigma * b.dof) / (a.sigma * a.sigma * a.dof)), 1e-3);
+  for (const auto& name : a.names) {
+    const ParameterEstimate& pa = a.parameters.at(name);
+    if (!(pa.std_error > 0)) continue;
+    EXPECT_NEAR(b.parameters.at(name).value, pa.value, 0.05 * pa.std_error) << name;
+  }
+}
+
+// A refinement started from a refined fit and its fitted q(t0) (Estimate::initial_slow_state,
+// as explain starts its one-term extensions) starts at that optimum's cost and ends there; from
+// the same values and the first measured sample it starts well above it.
+TEST(CeresRefinement, StartFromAFittedInitialStateStartsAtTheOptimum) {
+  const SlowRecord record = longXiRecord(13);
+  const Estimate start = startEstimate("xi", ExperimentMode::kFreeDecay, kFreeTruth, 0.05);
+  CeresOptions o;
+  o.coarse_samples = 0;
+  const Estimate a = refineWithCeres(record, start, o);
+  ASSERT_EQ(a.initial_slow_state.size(), 4);
+  for (int c = 0; c < 4; ++c) EXPECT_NEAR(a.initial_slow_state[c], kQ0[c], 5 * 2e-3) << c;
+  const Estimate b = refineWithCeres(record, a, o);
+  EXPECT_NEAR(initialCost(b), finalCost(a), 1e-6 * finalCost(a))
+      << solverNote(a) << " / " << solverNote(b);
+  Estimate without_state = a;
+  without_state.initial_slow_state.resize(0);
+  const Estimate c = refineWithCeres(record, without_state, o);
+  EXPECT_GT(initialCost(c), 1.01 * finalCost(a)) << solverNote(c);
+  for (const auto& name : a.names) {
+    const ParameterEstimate& pa = a.parameters.at(name);
+    EXPECT_NEAR(b.parameters.at(name).value, pa.value, 1e-3 * pa.std_error) << name;
+  }
+}
+
 // Slow samples with filtered noise (a 3-tap moving average: rho_1 = 2/3, rho_2 = 1/3, long-run
 // variance 3x the white formula's) whose record states that correlation, as a demodulated record
 // does (demodulator_noise.h): the intervals must cover the truth. With the white-noise formula

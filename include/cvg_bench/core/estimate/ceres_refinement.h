@@ -30,6 +30,18 @@ struct CeresOptions {
   int max_iterations = 200;
   /// Relative cost change at which Ceres stops, > 0.
   double function_tolerance = 1e-14;
+  /// On records of at least likelihood_tolerance_min_samples samples Ceres also stops when a step
+  /// lowers n ln(RSS) (n residuals: the scale of the selection criteria and of the likelihood
+  /// behind the intervals) by less than this, >= 0: the relative function tolerance becomes
+  /// max(function_tolerance, likelihood_tolerance / n). At 1e-4 the optimum left is below ~1e-3
+  /// in chi^2, the values within ~0.03 standard errors of it; a misfit model's flat valley
+  /// otherwise takes tens of passes over the whole record for changes of 1e-9 of its cost
+  /// (docs/benchmarks.md). 0 = function_tolerance alone.
+  double likelihood_tolerance = 1e-4;
+  /// Samples (free decay) or sweep points from which likelihood_tolerance applies, >= 0. Shorter
+  /// records keep the tight tolerances: they cost little, and in a rank-deficient valley the
+  /// rank decision depends on how far along it the solver went.
+  long likelihood_tolerance_min_samples = 80000;
   /// Relative parameter change at which Ceres stops, > 0.
   double parameter_tolerance = 1e-12;
   /// Max-norm of the gradient at which Ceres stops, > 0.

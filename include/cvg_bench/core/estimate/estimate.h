@@ -93,6 +93,9 @@ struct Estimate {
   /// Free decay: c with c'z = the envelope decay rate gamma_env of the record (Q = omega /
   /// gamma_env), in `names` order; empty otherwise.
   Eigen::VectorXd envelope_coefficients;
+  /// Free decay, output-error fit: the fitted initial slow variables q(t0) (4 nuisance unknowns,
+  /// not parameters); as a refinement's start, where its integration begins. Empty otherwise.
+  Eigen::VectorXd initial_slow_state;
 };
 
 }  // namespace cvg_bench

@@ -50,6 +50,9 @@ struct PipelineOptions {
   /// nested model's refined fit: explain's one-term extensions), the other parameters keeping
   /// their LS values; the start is then near the optimum and the coarse start is skipped.
   std::map<std::string, double> ceres_start;
+  /// With ceres_start: the initial slow variables q(t0) to start from (that fit's
+  /// Estimate::initial_slow_state); empty = the first measured sample.
+  Eigen::VectorXd ceres_start_state;
 
   /// Every problem with the options (of both stages), empty when valid.
   std::vector<std::string> validate() const;
