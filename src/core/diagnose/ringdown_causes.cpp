@@ -233,6 +233,51 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     }
     if (best < 0 || s.information_criterion < steps[best].information_criterion) best = k;
   }
+  // The detector's filter from the floor, and the choice between the two amplitude laws re-made
+  // through it from the plateau on (ringdown_filter.h): the span skips the filter's settling, which
+  // is where a law in A^2 spends its extra rate.
+  x.detector_filter =
+      estimateDetectorFilter(env, x.segment, x.baseline.p(1) / x.baseline.t_scale_s);
+  if (best >= 0 && isAmplitudeLaw(steps[best].added)) {
+    int rival = -1;
+    for (int k = 0; k < nc; ++k)
+      if (k != best && ok[k] && isAmplitudeLaw(steps[k].added) && steps[k].physical &&
+          steps[k].significant)
+        rival = k;
+    if (rival < 0) {
+      x.law_choice = "the other amplitude law does not pass: no second comparison";
+    } else if (!x.detector_filter.found) {
+      x.law_choice = "no detector filter estimated: the laws compared on the span alone";
+    } else {
+      const RingdownFilteredFit fb =
+          fitRingdownThroughFilter(env, x.segment, fits[best], x.detector_filter, ar);
+      const RingdownFilteredFit fr =
+          fitRingdownThroughFilter(env, x.segment, fits[rival], x.detector_filter, ar);
+      auto physical = [](const RingdownFilteredFit& f) {
+        return f.ok && f.p(1) > 0.0 && f.p(2) > 0.0;
+      };
+      std::ostringstream w;
+      if (fb.ok) x.law_choice_sse[fb.model] = fb.sse_whitened;
+      if (fr.ok) x.law_choice_sse[fr.model] = fr.sse_whitened;
+      const bool pb = physical(fb), pr = physical(fr);
+      if (pb && pr) {
+        w << "through the detector filter from " << fmt(fb.t_start_s) << " s (drive-off fitted at "
+          << fmt(fb.drive_off_s) << " s): AR-whitened SSE " << fb.model << " "
+          << fmt(fb.sse_whitened) << ", " << fr.model << " " << fmt(fr.sse_whitened) << " over "
+          << fb.n << " samples";
+        if (fr.sse_whitened < fb.sse_whitened) best = rival;
+        w << " -> " << steps[best].added << " (the span alone: " << fb.model << ")";
+      } else if (pb != pr) {
+        w << "through the detector filter only " << (pb ? fb.model : fr.model)
+          << " fits with positive damping";
+        if (pr) best = rival;
+      } else {
+        w << "through the detector filter neither law fits with positive damping: the laws "
+             "compared on the span alone";
+      }
+      x.law_choice = w.str();
+    }
+  }
   // Hold-out confirmation of the pick against the single exponential (and, for a beat or a
   // two-stage decay, against the best physical amplitude law).
   if (best >= 0) {
