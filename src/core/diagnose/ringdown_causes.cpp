@@ -277,6 +277,42 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
       }
       x.law_choice = w.str();
     }
+  } else if (best < 0 && x.detector_filter.found) {
+    // No extension on the span: the amplitude laws against the single exponential once more
+    // through the filter from the plateau on (the same criterion and margin, on those samples).
+    const RingdownFilteredFit fl =
+        fitRingdownThroughFilter(env, x.segment, x.baseline, x.detector_filter, ar);
+    auto icf = [](const RingdownFilteredFit& f) {
+      return f.n * std::log(std::max(f.sse_whitened, 1e-300) / f.n) +
+             static_cast<double>(f.p.size()) * std::log(static_cast<double>(f.n));
+    };
+    std::ostringstream w;
+    w.precision(6);
+    if (fl.ok) {
+      x.law_choice_sse["linear"] = fl.sse_whitened;
+      w << "no extension on the span; through the detector filter from " << fmt(fl.t_start_s)
+        << " s: criterion linear " << icf(fl);
+      int pick = -1;
+      double ic_pick = icf(fl) - options.margin;
+      for (int k = 0; k < nc; ++k) {
+        if (!ok[k] || !isAmplitudeLaw(steps[k].added) || !steps[k].physical) continue;
+        const RingdownFilteredFit f =
+            fitRingdownThroughFilter(env, x.segment, fits[k], x.detector_filter, ar);
+        if (!f.ok || f.n != fl.n) continue;
+        x.law_choice_sse[f.model] = f.sse_whitened;
+        const bool phys = f.p(1) > 0.0 && f.p(2) > 0.0;
+        w << ", " << f.model << " " << icf(f) << (phys ? "" : " (negative damping)");
+        if (phys && icf(f) < ic_pick) ic_pick = icf(f), pick = k;
+      }
+      if (pick >= 0) {
+        best = pick;
+        steps[pick].note =
+            "criterion below the single exponential's by the margin through the "
+            "detector filter (from the plateau on)";
+      }
+      w << " -> " << (pick >= 0 ? steps[pick].added : std::string("linear"));
+    }
+    x.law_choice = w.str();
   }
   // Hold-out confirmation of the pick against the single exponential (and, for a beat or a
   // two-stage decay, against the best physical amplitude law).

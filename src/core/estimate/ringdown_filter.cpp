@@ -123,9 +123,9 @@ RingdownDetectorFilter estimateDetectorFilter(const RingdownEnvelope& env,
   size_t a = 0;
   while (a < t.size() && t[a] < t_a) ++a;
   const size_t m = t.size() - std::min(a, t.size());
-  if (m < 200) {
+  if (m < 120) {
     std::ostringstream w;
-    w << m << " samples of floor 6 dB below the decay's continuation, under 200";
+    w << m << " samples of floor 6 dB below the decay's continuation, under 120";
     return none(w.str());
   }
   std::vector<double> dts;
@@ -147,7 +147,7 @@ RingdownDetectorFilter estimateDetectorFilter(const RingdownEnvelope& env,
     X(nv, 0) = 1.0, X(nv, 1) = std::exp(-2.0 * decay_rate_1_s * (t[i] - t[a]));
     p[k] = P(nv), ++nv;
   }
-  if (nv < 200) return none("under 200 valid floor samples");
+  if (nv < 120) return none("under 120 valid floor samples");
   const Eigen::VectorXd c = X.topRows(nv).colPivHouseholderQr().solve(P.head(nv));
   for (size_t k = 0; k < m; ++k)
     if (valid[k]) p[k] -= c(0) + c(1) * std::exp(-2.0 * decay_rate_1_s * (t[a + k] - t[a]));

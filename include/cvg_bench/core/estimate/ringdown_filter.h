@@ -45,7 +45,7 @@ struct RingdownDetectorFilter {
 double ringdownFilterPowerCorrelation(int order, double x);
 
 /// The filter from the noise floor (see the header comment); found = false (and why) when the
-/// record has no floor stretch of 200 samples or more, the sampling is not uniform, or the
+/// record has no floor stretch of 120 samples or more, the sampling is not uniform, or the
 /// correlation at lag 1 is under 0.2 (a filter shorter than the sample interval: negligible).
 /// decay_rate_1_s: the decay's amplitude rate (the straight fit's), for the floor stretch's start.
 RingdownDetectorFilter estimateDetectorFilter(const RingdownEnvelope& env,
