@@ -29,17 +29,24 @@ double factorial(int k) {
   return f;
 }
 
+/// Integral of rho_n(x)^2 over x >= 0 (the power's correlation time over T).
+double correlationTime(int order) {
+  static const double c[kMaxOrder] = {0.5, 1.25, 1.75, 2.145};
+  return c[std::max(1, std::min(kMaxOrder, order)) - 1];
+}
+
 /// Sum of squares of the power autocorrelation r[1..K] against (rho_n(k / T)^2 - b) / (1 - b)
 /// (T in samples): b >= 0 is the bias of an autocorrelation taken about an estimated mean and
-/// trend (of the order of the correlation time over the stretch's length), fitted in closed
-/// form, at most 0.15.
-double correlationMisfit(int order, double t_samples, const std::vector<double>& r) {
+/// trend (about twice the correlation time over the stretch's length m), fitted in closed form,
+/// at most 4 correlation times over m and 0.15.
+double correlationMisfit(int order, double t_samples, const std::vector<double>& r, double m) {
   double sxy = 0.0, sxx = 0.0;
   for (size_t k = 1; k < r.size(); ++k) {
     const double x = ringdownFilterPowerCorrelation(order, k / t_samples) - 1.0;
     sxy += x * (r[k] - 1.0), sxx += x * x;
   }
-  const double alpha = std::min(1.0 / 0.85, std::max(1.0, sxx > 0.0 ? sxy / sxx : 1.0));
+  const double b_max = std::min(0.15, 4.0 * correlationTime(order) * t_samples / m);
+  const double alpha = std::min(1.0 / (1.0 - b_max), std::max(1.0, sxx > 0.0 ? sxy / sxx : 1.0));
   double s = 0.0;
   for (size_t k = 1; k < r.size(); ++k) {
     const double e =
@@ -194,7 +201,7 @@ RingdownDetectorFilter estimateDetectorFilter(const RingdownEnvelope& env,
     int kb = 0;
     double eb = std::numeric_limits<double>::infinity();
     for (int g = 0; g < ng; ++g) {
-      const double e = correlationMisfit(order, std::exp(lo + (hi - lo) * g / (ng - 1)), r);
+      const double e = correlationMisfit(order, std::exp(lo + (hi - lo) * g / (ng - 1)), r, m);
       if (e < eb) eb = e, kb = g;
     }
     double u0 = lo + (hi - lo) * std::max(0, kb - 1) / (ng - 1);
@@ -202,13 +209,14 @@ RingdownDetectorFilter estimateDetectorFilter(const RingdownEnvelope& env,
     const double gr = 0.5 * (std::sqrt(5.0) - 1.0);
     for (int it = 0; it < 40; ++it) {
       const double x1 = u1 - gr * (u1 - u0), x2 = u0 + gr * (u1 - u0);
-      if (correlationMisfit(order, std::exp(x1), r) < correlationMisfit(order, std::exp(x2), r))
+      if (correlationMisfit(order, std::exp(x1), r, m) <
+          correlationMisfit(order, std::exp(x2), r, m))
         u1 = x2;
       else
         u0 = x1;
     }
     const double ts = std::exp(0.5 * (u0 + u1));
-    const double e = correlationMisfit(order, ts, r);
+    const double e = correlationMisfit(order, ts, r, m);
     if (e < best) best = e, f.order = order, f.time_constant_s = ts * dt;
   }
   f.found = true;

@@ -8,8 +8,10 @@
 //   rho_4 = (1 + x + 2 x^2/5 + x^3/15) e^{-x}   (x = s / T).
 // The floor stretch starts where the decay's straight continuation has fallen 6 dB below the floor
 // (its residual signal power is removed by a fit c0 + c1 e^{-2 g t}); the empirical autocorrelation
-// of P over lags 1..K (K: where it falls under 0.05) is fitted by rho_n^2 for n = 1..4 and T on a
-// log grid refined by golden section; the order with the smallest sum of squares wins.
+// of P over lags 1..K (K: where it falls under 0.05) is fitted by (rho_n^2 - b) / (1 - b) for
+// n = 1..4 and T on a log grid refined by golden section (b >= 0 the bias of a correlation taken
+// about a fitted mean, at most 4 correlation times over the stretch's length); the order with the
+// smallest sum of squares wins.
 //
 // The filtered envelope model (ringdownFilteredLogAmplitude): the detector input is the plateau
 // level A(t_off) before the drive-off t_off and the damping law A(t) after it; the output is that
