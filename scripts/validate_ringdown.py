@@ -24,9 +24,9 @@ Thresholds (fixed before running): Q coverage of the 95 % interval in [0.90, 0.9
 detected (the right name selected; det_loss: `unexplained`) in >= 95 %; false alarms on clean
 records (any extension selected or `unexplained`) <= 5 %; floor found in >= 95 % of records with a
 floor and claimed in <= 5 % without. Rates carry Wilson 95 % intervals. Tuning runs use other seed
-bases than the reporting run (`--seed-base`; the reporting base is the default, 88412207, first
-used after tuning on bases 41000000, 42000000 and 43000000; 20261125, 30261125 and 71829304 are
-spent). 60 records a class: a Wilson interval of +-0.06 at 0.95, enough to tell 0.90 from 0.98.
+bases than the reporting run (`--seed-base`; the reporting base is the default, 93517331, first
+used after the detector-filter change was tuned on bases 41000000, 42000000 and 43000000;
+20261125, 30261125, 71829304 and 88412207 are spent). 60 records a class: a Wilson interval of +-0.06 at 0.95, enough to tell 0.90 from 0.98.
 
 Usage: validate_ringdown.py [--markdown FILE] [--n N] [--seed-base S] [--classes a,b] [--jobs J]
 """
@@ -62,38 +62,83 @@ now the larger of the AR sandwich and a cluster sandwich of the scores over 16 c
 (Student df 16 - p where the blocks win); `interval_method` names both. The lack-of-fit test keeps
 the AR covariance alone (the blocks absorb a misfit localized in time).
 
+## Detector filter and the amplitude laws (the change behind this run)
+
+The previous reporting run (base 88412207) missed gamma_nl in 11 of 60 records, 9 of them called
+gamma_a: the fitted span skips the lock-in's settling after the drive-off, which is where a law
+in A^2 spends its extra rate (next section). The tool now estimates the detector's low-pass where
+no damping law acts, in the noise floor (src/core/estimate/ringdown_filter.cpp): for white noise
+at the detector input the floor's power P = |z|^2 has the autocorrelation rho_n(s / T)^2 exactly
+(n equal real poles of time constant T); the empirical autocorrelation of P, from 6 dB below the
+decay's continuation to the end (120 samples or more, 8 filter lengths or more), is fitted for
+n = 1..4 and T (with the bias of a correlation about a fitted mean). The filter is then held
+fixed, and (1) when the span picks an amplitude law and the other law also passes, both are
+refitted from the plateau on through the filter (each law switched on at a fitted drive-off time,
+the plateau at the law's level there, convolved with the n-pole response) and the lower
+AR-whitened sum of squares wins; (2) when the span picks no extension, the laws are compared with
+the line through the filter by the same criterion and margin (BIC, 20). A change of the span's
+choice needs the same answer with T at 1/1.4, 1 and 1.4 times its estimate: a filter taken too
+slow rounds the modelled corner too much and favours the A^2 law (on tuning base 42000000 three
+gamma_a records flipped to gamma_nl that way before this rule). Beat and two-stage picks are not
+touched. The JSON gives `detector_filter` (found, source, order, time_constant_s, why) and
+`law_choice` (why, AR-whitened sums of squares); the printout says the same; with no floor (or too
+short a floor) the old behaviour stays and says so.
+
+The filter estimate on tuning floors (270 clean, gamma_nl and gamma_a records of bases 41000000,
+42000000, 43000000; the generator's lock-in has 2 poles): found in 227; order 2 in 93, 1 in 34,
+3 in 40, 4 in 60 (the order is weakly identified by the first lags); the floor power's
+correlation time, the quantity the data fix, 1.00x the truth at the median, 10-90 % 0.72 .. 1.49.
+On this run's 360 records a filter was found in 311 (order 2 in 130, 4 in 86, 3 in 55, 1 in 40).
+Known-answer tests: test/core/estimate/ringdown_filter_test.cpp (the power correlation of 1..4
+poles; T of 1- and 2-pole floors within 20 % in correlation time; the one-pole filtered decay
+against its closed form; an A^2 law fitted through the estimated filter: g0 within 10 %, g2
+within 25 %, sum of squares below the A law's).
+
+Tuning (30 records a class on each of the three tuning bases; the span-only choice read from
+`law_choice`): gamma_nl 25/26/23 -> 27/28/29 (74 -> 84 of 90), gamma_a 88 -> 89 of 90, clean
+false alarms 4 of 90 before and after (none from the new step), no right -> wrong change. This
+run (base 93517331, read after it, no tuning on it): the step changed 12 verdicts, 10 gamma_nl
+records wrong -> right (5 gamma_a -> gamma_nl, 5 linear -> gamma_nl), 1 gamma_nl right -> wrong
+(93617345, extra rate 2.5 g0: the A^2 law fitted with negative damping through all three filters,
+so only gamma_a remained) and 1 clean record right -> wrong (93517369: a line through the filter
+worse than an A^2 law by 124 .. 331, i.e. the filtered line does not fit that record's corner;
+not analysed further). gamma_nl went from 45 of 60 (the span's choice on these records) to 54 of
+60, short of 0.95: of the 6 misses, 3 are called gamma_a with filtered sums of squares within
+0.3 % of each other at every filter (extra rate 0.72, 1.99, 1.94 g0: the records do not separate
+the laws; the span's choice stays), 1 is the record above, and 2 are called two_stage (a pick the
+new step does not touch). Time per record rose by about 0.5 s (median 1.9 s here).
+
 ## Before / after
 
-Before: the previous reporting run, 20 records a class on base 71829304 (the same tool as this
-run; only the run's size and the seed base changed): Q coverage 19/20 (0.950 [0.764, 0.991]),
-clean false alarms 1/20 (0.050 [0.009, 0.236]), gamma_nl 16/20 (0.800 [0.584, 0.919]), gamma_a
-20/20 (1.000 [0.839, 1.000]), beat 18/20 (0.900 [0.699, 0.972]), two_stage 18/20 (0.900 [0.699,
-0.972]), detection loss 20/20 (1.000 [0.839, 1.000]), floor found 13/14 (0.929 [0.685, 0.987]),
-floor claimed without one 0/6. After: the tables above (60 a class, fresh base). Twenty a class
-could not separate 0.90 from 0.98 coverage (interval width ~0.23); sixty narrows it to ~0.12.
-Run time of this run (base 88412207): 360 records in 680 s wall (11 min 21 s) with 2 jobs on the
-2-core machine while other jobs ran (load average ~4.5), 51 MB peak memory: the ring-down part of
-`make validate` fits its 30-minute budget. Read after the run (no tuning on it): 9 of the 11
-gamma_nl misses were called gamma_a (the close call explained below); the 5 beat misses were
-all left as a single exponential, 3 of them with the second mode decaying 1.5x slower than the
-first, and in 4 the beat fit found no modulation at all (criterion within its penalty of the
-line's): a start problem of the split search, not a threshold. Checked on tuning seeds after
-the run (base 42000000, beat class, 60 records: 54 detected, 6 missed, plus the one miss of base
-41000000): a plain least-squares fit of the beat envelope on ln A, started on a grid of splits
-(1.5 .. 30 cycles per span in steps of 0.25) with second-mode ratios 0.1 and 0.3, rate ratios 0.7,
-1 and 1.5 and four phases, found the true split within 0.2 cycles per span in 6 of the 7. In 3
-of them it cut the line's sum of squares to 0.16, 0.26 and 0.37 of it where the tool's beat fit
-had reached 0.54, 0.58 and 0.68 (a start problem: the periodogram starts have equal rates,
-d2 = d1, and these second modes decay 1.4 .. 1.6x slower than the first); in 1 the tool's best beat
-had a negative rate where the grid found a physical one at a similar fit; in 2 the tool's fit was
-as good and its AR-whitened criterion judged the beat not significant under the records'
-correlated noise. A split grid with unequal-rate starts is the next step for the beat (not done
-here: it changes the tool after this reporting run). The detection rows count the
-right name selected; the verdict table shows that the account is not always clean: 21 of the 55
-detected beats, 10 of the 57 two-stage decays and 2 + 2 of the amplitude laws also carry
-`unexplained` (the lack-of-fit test finds structure left in their residuals; its source was
-not analysed), and 14 of the 60 detection-loss records name a two-stage decay beside
-`unexplained`.
+Before: the previous reporting run, base 88412207, 60 a class, tool before the detector filter:
+Q coverage 57/60 (0.950 [0.863, 0.983]), clean false alarms 1/60 (0.017 [0.003, 0.089]), gamma_nl
+49/60 (0.817 [0.701, 0.894]), gamma_a 59/60 (0.983 [0.911, 0.997]), beat 55/60 (0.917 [0.819,
+0.964]), two_stage 57/60 (0.950 [0.863, 0.983]), detection loss 60/60, floor found 42/42, floor
+claimed without one 0/18. After: the tables above (fresh base 93517331, committed before its one
+run; thresholds unchanged). Only the amplitude-law choice changed in the tool; the other rows
+moved with the records: Q coverage 57 -> 53 of 60 and two_stage 57 -> 55 (the final fit of a
+clean record, and every beat or two-stage pick, is the same computation as before), beat 55 -> 57
+(beat fits unchanged), clean false alarms 1 -> 5 (1 from the new step, 2 beats and 2
+`unexplained` from the unchanged parts). With 60 records a row's Wilson interval is about
++-0.07, so neither base separates 0.90 from 0.95 on coverage; the two bases together give Q
+coverage 110/120 (0.917 [0.853, 0.954]). Run time: 360 records in 413 s wall with 2 jobs on the
+2-core machine beside other work, median 1.94 s, max 7.7 s per record.
+
+Earlier: base 71829304 (20 a class) gave Q coverage 19/20, clean false alarms 1/20, gamma_nl 16/20,
+gamma_a 20/20, beat 18/20, two_stage 18/20, detection loss 20/20, floor found 13/14.
+
+Beat misses (previous run, checked on tuning seeds after it; tool unchanged for beats): a plain
+least-squares fit of the beat envelope started on a grid of splits with unequal-rate starts found
+the true split in 6 of 7 missed records of bases 41000000/42000000, but in the tool (branch
+ring2, not merged) it moved tuning detection only 54 -> 55 of 60 at 1.7x the time; the remaining
+misses are beats the AR-whitened criterion judges not significant and fits with a negative second
+rate. On the tuning dumps of this change (bases 41000000, 42000000, 30 beats each) the 11 beats
+that also carry `unexplained` are mostly records where the segmentation found no noise floor (7 of
+11, against 4 of the 46 clean beat verdicts), all 7 with a second mode decaying 1.3 .. 1.6x slower
+than the first: the slow mode takes over late in the decay and the straight-line-plus-floor test
+of the segmentation does not see the floor, so the span runs into it and the beat model (no floor
+term) leaves structure for the lack-of-fit test. On this run the association is weaker (3 of 14
+against 4 of 43). Not changed here.
 
 ## Why gamma_nl is the hard cause (tuning base 41000000, 30 records a class)
 
@@ -110,8 +155,9 @@ worse; (2) fitting from the drive-off with the 2-pole filter's transient in ever
 16/30: the transient and the law's early curvature trade off, and a model that rejects the
 transient (k < 0) is left with an unmodelled corner that the lack-of-fit test flags. Taking the
 best start with positive rates for the beat and two-stage fits changed no verdict on 30 + 30
-tuning records (left out). A model of the instrument's filter (order and time constant from the
-plateau's corner, convolved with each law) is the next step; it is not done.
+tuning records (left out). The detector filter of the next section is the step taken: the filter is
+estimated where no damping law acts (the floor) and then held fixed, so it cannot trade off with
+the law.
 
 ## Comparison with mdovale/RingDownAnalysis
 
@@ -148,9 +194,10 @@ own plateau handling is in its demodulation stage, not in these formulas). The p
 applied to the linear envelope with amplitude and offset linear (the envelope's form of its
 cos/sin/offset projection); the envelope formula's +-1.96 se interval is ours (the peer reports the
 se only). Both assume white noise; the records' noise is coloured (lock-in filter, AR(1) relative
-noise), which is what their coverage shows: on base 88412207 both give Q as accurate as cvg_bench
-(median error 0.28 % and 0.15 % against 0.13 %) with intervals 0.64x and 0.35x as wide that
-contain the true Q in 50 % and 47 % of the records, where cvg_bench's contain it in 95 %."""
+noise), which is what their coverage shows: on base 93517331 both give Q as accurate as cvg_bench
+(median error 0.30 % and 0.19 % against 0.16 %) with intervals 0.68x and 0.38x as wide that
+contain the true Q in 43 % and 45 % of the records, where cvg_bench's contain it in 88 % (95 % on
+the previous base 88412207, where the peer's were 50 % and 47 %)."""
 
 
 def wilson(k, n, z=1.96):
@@ -428,7 +475,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--markdown")
     ap.add_argument("--n", type=int, default=60, help="records per class")
-    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=88412207,
+    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=93517331,
                     help="first seed (the reporting run uses the default; tune on others)")
     ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated subset")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("VALIDATE_JOBS", "2")))

@@ -111,6 +111,14 @@ nlohmann::json ringdownExplanationToJson(const RingdownExplanation& x, double co
                      "BIC on the effective sample size; beat and two_stage must also "
                      "beat the physical amplitude laws; pick confirmed on hold-out"},
                     {"information_criterion", x.information_criterion}};
+  const RingdownDetectorFilter& df = x.detector_filter;
+  j["detector_filter"] = {
+      {"found", df.found},
+      {"source", df.source},
+      {"order", df.order},
+      {"time_constant_s", df.found ? num(df.time_constant_s) : nlohmann::json()},
+      {"why", df.why}};
+  j["law_choice"] = {{"why", x.law_choice}, {"sse_whitened", x.law_choice_sse}};
   j["selected"] = x.selected;
   j["unexplained"] = x.unexplained;
   j["adequate"] = x.adequate;

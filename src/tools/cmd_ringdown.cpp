@@ -270,6 +270,8 @@ int runRingdownExplain(const std::vector<std::string>& argv) {
   std::cout << "selected: " << (x.selected.empty() ? "none" : x.selected.front())
             << "; unexplained: " << (x.unexplained ? "yes" : "no")
             << "; lack of fit p = " << x.lack_of_fit_p << "\n";
+  std::cout << "detector filter: " << x.detector_filter.why << "\n";
+  if (!x.law_choice.empty()) std::cout << "amplitude law choice: " << x.law_choice << "\n";
   std::cout << "final model:\n";
   printFit(x.final_fit, x.segment, std::cout);
   std::cout << "verdict: " << x.cause << "\n";

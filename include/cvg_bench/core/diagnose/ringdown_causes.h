@@ -12,7 +12,11 @@
 // `margin` below the single exponential's; every fitted damping must be positive and an amplitude
 // law's coefficient positive (sign check), else the law is not physical; a beat or a two-stage
 // decay must also lie `law_margin` below every physical amplitude law (they can bend a decay the
-// same way with more parameters). The lowest criterion wins and is confirmed on hold-out (blocked
+// same way with more parameters). The lowest criterion wins. When it is an amplitude law and the
+// other law also passes, the two are compared once more through the detector's filter estimated
+// from the floor (fitted from the plateau on, ringdown_filter.h; the lower AR-whitened sum of
+// squares, both having four parameters), since the span that skips the filter's settling also
+// skips where a law in A^2 differs from one in A. The pick is confirmed on hold-out (blocked
 // two-fold prediction error below the single exponential's and the rival law's; for a beat or a
 // two-stage decay below 0.9 of it). An amplitude law
 // with a negative coefficient that beats every physical model by the margin means the decay
@@ -24,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "cvg_bench/core/estimate/ringdown_filter.h"
 #include "cvg_bench/core/estimate/ringdown_fit.h"
 
 namespace cvg_bench {
@@ -68,6 +73,13 @@ struct RingdownExplanation {
   std::string lack_of_fit_test;
   double lack_of_fit_p = 1.0;
   std::string cause;  ///< sentences a bench engineer can act on
+  /// The detector's low-pass from the noise floor (ringdown_filter.h) and, when the pick is an
+  /// amplitude law and the other law is a significant physical rival, the choice between the two
+  /// re-made from the plateau through that filter (the first decibels after the drive-off
+  /// included): what was compared and why.
+  RingdownDetectorFilter detector_filter;
+  std::string law_choice;
+  std::map<std::string, double> law_choice_sse;  ///< AR-whitened SSE per law, filtered fits
 };
 
 RingdownExplanation explainRingdown(const RingdownEnvelope& env,

@@ -1,0 +1,344 @@
+#include "cvg_bench/core/estimate/ringdown_filter.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <sstream>
+
+#include "cvg_bench/core/estimate/ringdown_intervals.h"
+#include "cvg_bench/core/estimate/ringdown_models.h"
+
+namespace cvg_bench {
+namespace {
+
+constexpr double kDbPerNeper = 20.0 / 2.302585092994046;
+constexpr int kMaxOrder = 4;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return v[m];
+}
+
+double factorial(int k) {
+  double f = 1.0;
+  for (int i = 2; i <= k; ++i) f *= i;
+  return f;
+}
+
+/// Integral of rho_n(x)^2 over x >= 0 (the power's correlation time over T).
+double correlationTime(int order) {
+  static const double c[kMaxOrder] = {0.5, 1.25, 1.75, 2.145};
+  return c[std::max(1, std::min(kMaxOrder, order)) - 1];
+}
+
+/// Sum of squares of the power autocorrelation r[1..K] against (rho_n(k / T)^2 - b) / (1 - b)
+/// (T in samples): b >= 0 is the bias of an autocorrelation taken about an estimated mean and
+/// trend (about twice the correlation time over the stretch's length m), fitted in closed form,
+/// at most 4 correlation times over m and 0.15.
+double correlationMisfit(int order, double t_samples, const std::vector<double>& r, double m) {
+  double sxy = 0.0, sxx = 0.0;
+  for (size_t k = 1; k < r.size(); ++k) {
+    const double x = ringdownFilterPowerCorrelation(order, k / t_samples) - 1.0;
+    sxy += x * (r[k] - 1.0), sxx += x * x;
+  }
+  const double b_max = std::min(0.15, 4.0 * correlationTime(order) * t_samples / m);
+  const double alpha = std::min(1.0 / (1.0 - b_max), std::max(1.0, sxx > 0.0 ? sxy / sxx : 1.0));
+  double s = 0.0;
+  for (size_t k = 1; k < r.size(); ++k) {
+    const double e =
+        r[k] - 1.0 - alpha * (ringdownFilterPowerCorrelation(order, k / t_samples) - 1.0);
+    s += e * e;
+  }
+  return s;
+}
+
+/// Levenberg-Marquardt on a residual function (steps by QR of [J; sqrt(lambda) D], Jacobian by
+/// central differences). Returns false when the start gives no finite residuals.
+bool minimize(const std::function<bool(const Eigen::VectorXd&, Eigen::VectorXd&)>& res,
+              Eigen::VectorXd& p, double& sse) {
+  Eigen::VectorXd r;
+  if (!res(p, r)) return false;
+  sse = r.squaredNorm();
+  double lambda = 1e-3;
+  Eigen::VectorXd rp, rm;
+  for (int it = 0; it < 80; ++it) {
+    Eigen::MatrixXd J(r.size(), p.size());
+    for (int k = 0; k < p.size(); ++k) {
+      const double h = 1e-6 * (1.0 + std::fabs(p(k)));
+      Eigen::VectorXd pp = p, pm = p;
+      pp(k) += h, pm(k) -= h;
+      if (!res(pp, rp) || !res(pm, rm)) return true;
+      J.col(k) = -(rp - rm) / (2.0 * h);
+    }
+    const Eigen::VectorXd dscale = J.colwise().norm().cwiseMax(1e-12);
+    bool improved = false;
+    for (int inner = 0; inner < 12 && !improved; ++inner) {
+      Eigen::MatrixXd A(J.rows() + p.size(), p.size());
+      Eigen::VectorXd b = Eigen::VectorXd::Zero(J.rows() + p.size());
+      A.topRows(J.rows()) = J;
+      A.bottomRows(p.size()) = (std::sqrt(lambda) * dscale).asDiagonal();
+      b.head(J.rows()) = r;
+      const Eigen::VectorXd step = A.colPivHouseholderQr().solve(b);
+      const Eigen::VectorXd pn = p + step;
+      Eigen::VectorXd rn;
+      if (res(pn, rn) && rn.squaredNorm() < sse) {
+        const double rel = (sse - rn.squaredNorm()) / std::max(sse, 1e-300);
+        p = pn, r = rn, sse = rn.squaredNorm();
+        lambda = std::max(lambda / 5.0, 1e-12);
+        improved = true;
+        if (rel < 1e-10 || step.norm() < 1e-12 * (1.0 + p.norm())) return true;
+      } else {
+        lambda *= 8.0;
+      }
+    }
+    if (!improved) return true;
+  }
+  return true;
+}
+
+}  // namespace
+
+double ringdownFilterPowerCorrelation(int order, double x) {
+  x = std::fabs(x);
+  // rho_n(x) = e^{-x} sum_j C(m, j) x^{m-j} (j+m)! / 2^{j+m+1} / (same at x = 0), m = n - 1:
+  // the integral of s^m (s + x)^m e^{-2 s} ds.
+  const int m = std::max(0, std::min(kMaxOrder, order) - 1);
+  double num = 0.0;
+  for (int j = 0; j <= m; ++j)
+    num += factorial(m) / (factorial(j) * factorial(m - j)) * std::pow(x, m - j) *
+           factorial(j + m) / std::pow(2.0, j + m + 1);
+  const double den = factorial(2 * m) / std::pow(2.0, 2 * m + 1);
+  const double rho = std::exp(-x) * num / den;
+  return rho * rho;
+}
+
+RingdownDetectorFilter estimateDetectorFilter(const RingdownEnvelope& env,
+                                              const RingdownSegment& seg, double decay_rate_1_s) {
+  RingdownDetectorFilter f;
+  f.source = "none";
+  auto none = [&f](const std::string& why) {
+    f.why = "no detector filter estimated (" + why +
+            "): the first decibels after the drive-off "
+            "are skipped instead";
+    return f;
+  };
+  if (!seg.has_floor) return none("no noise floor in the record");
+  if (!(decay_rate_1_s > 0.0)) return none("no positive decay rate");
+  const auto& t = env.t_s;
+  const auto& y = env.log_amplitude;
+  // Level at the span's end above the floor; the stretch starts 6 dB below the floor on the
+  // decay's straight continuation.
+  std::vector<double> last;
+  for (size_t i = seg.i_end > 9 ? seg.i_end - 9 : 0; i < seg.i_end && i < y.size(); ++i)
+    if (!seg.dropout[i] && std::isfinite(y[i])) last.push_back(y[i]);
+  const double above = last.empty() ? 10.0 / kDbPerNeper : median(last) - seg.floor_log_amplitude;
+  const double t_a = seg.t_end_s + (above + 6.0 / kDbPerNeper) / decay_rate_1_s;
+  size_t a = 0;
+  while (a < t.size() && t[a] < t_a) ++a;
+  const size_t m = t.size() - std::min(a, t.size());
+  if (m < 120) {
+    std::ostringstream w;
+    w << m << " samples of floor 6 dB below the decay's continuation, under 120";
+    return none(w.str());
+  }
+  std::vector<double> dts;
+  for (size_t i = a + 1; i < t.size(); ++i) dts.push_back(t[i] - t[i - 1]);
+  const double dt = median(dts);
+  for (double d : dts)
+    if (std::fabs(d - dt) > 0.01 * dt) return none("sampling not uniform in the floor");
+  // Power re the floor, less the residual signal c1 e^{-2 g (t - t_a)} and the mean c0.
+  std::vector<double> p(m, 0.0);
+  std::vector<bool> valid(m, false);
+  Eigen::MatrixXd X(m, 2);
+  Eigen::VectorXd P(m);
+  int nv = 0;
+  for (size_t k = 0; k < m; ++k) {
+    const size_t i = a + k;
+    if (seg.dropout[i] || !std::isfinite(y[i])) continue;
+    valid[k] = true;
+    P(nv) = std::exp(2.0 * (y[i] - seg.floor_log_amplitude));
+    X(nv, 0) = 1.0, X(nv, 1) = std::exp(-2.0 * decay_rate_1_s * (t[i] - t[a]));
+    p[k] = P(nv), ++nv;
+  }
+  if (nv < 120) return none("under 120 valid floor samples");
+  const Eigen::VectorXd c = X.topRows(nv).colPivHouseholderQr().solve(P.head(nv));
+  for (size_t k = 0; k < m; ++k)
+    if (valid[k]) p[k] -= c(0) + c(1) * std::exp(-2.0 * decay_rate_1_s * (t[a + k] - t[a]));
+  const int k_max = static_cast<int>(std::min<size_t>(300, m / 4));
+  std::vector<double> r(1, 1.0);
+  double var = 0.0;
+  int nvar = 0;
+  for (size_t k = 0; k < m; ++k)
+    if (valid[k]) var += p[k] * p[k], ++nvar;
+  var /= std::max(1, nvar);
+  for (int lag = 1; lag <= k_max; ++lag) {
+    double s = 0.0;
+    int cnt = 0;
+    for (size_t k = 0; k + lag < m; ++k)
+      if (valid[k] && valid[k + lag]) s += p[k] * p[k + lag], ++cnt;
+    r.push_back(cnt > 0 ? s / cnt / std::max(var, 1e-300) : 0.0);
+    if (r.back() < 0.05) break;
+  }
+  f.n_samples = nv;
+  f.n_lags = static_cast<int>(r.size()) - 1;
+  if (r.size() < 2 || r[1] < 0.2) {
+    std::ostringstream w;
+    w.precision(3);
+    w << "floor power correlation at lag 1 is " << (r.size() > 1 ? r[1] : 0.0)
+      << ", under 0.2: a filter shorter than the sample interval";
+    return none(w.str());
+  }
+  if (static_cast<int>(r.size()) - 1 >= k_max) return none("floor correlation does not decay");
+  double best = std::numeric_limits<double>::infinity();
+  for (int order = 1; order <= kMaxOrder; ++order) {
+    // Log grid of T in samples, then golden section between the neighbours of the best node.
+    const int ng = 160;
+    const double lo = std::log(0.05), hi = std::log(400.0);
+    int kb = 0;
+    double eb = std::numeric_limits<double>::infinity();
+    for (int g = 0; g < ng; ++g) {
+      const double e = correlationMisfit(order, std::exp(lo + (hi - lo) * g / (ng - 1)), r, m);
+      if (e < eb) eb = e, kb = g;
+    }
+    double u0 = lo + (hi - lo) * std::max(0, kb - 1) / (ng - 1);
+    double u1 = lo + (hi - lo) * std::min(ng - 1, kb + 1) / (ng - 1);
+    const double gr = 0.5 * (std::sqrt(5.0) - 1.0);
+    for (int it = 0; it < 40; ++it) {
+      const double x1 = u1 - gr * (u1 - u0), x2 = u0 + gr * (u1 - u0);
+      if (correlationMisfit(order, std::exp(x1), r, m) <
+          correlationMisfit(order, std::exp(x2), r, m))
+        u1 = x2;
+      else
+        u0 = x1;
+    }
+    const double ts = std::exp(0.5 * (u0 + u1));
+    const double e = correlationMisfit(order, ts, r, m);
+    if (e < best) best = e, f.order = order, f.time_constant_s = ts * dt;
+  }
+  f.found = true;
+  f.source = "noise_floor";
+  f.fit_rms = std::sqrt(best / f.n_lags);
+  // A floor stretch under 8 filter lengths (n T) gives an autocorrelation too noisy to trust.
+  if (m * dt < 8.0 * f.order * f.time_constant_s) {
+    f.found = false;
+    return none("floor shorter than 8 filter lengths");
+  }
+  std::ostringstream w;
+  w.precision(3);
+  w << "detector low-pass of " << f.order << " pole" << (f.order > 1 ? "s" : "")
+    << ", T = " << f.time_constant_s << " s each, from the correlation of the floor's power (" << nv
+    << " samples after " << t[a] << " s, lags 1.." << f.n_lags << ", rms misfit " << f.fit_rms
+    << "); assumed to act on the amplitude (a lock-in's output filter)";
+  f.why = w.str();
+  return f;
+}
+
+std::vector<double> ringdownFilteredLogAmplitude(const std::string& law, const Eigen::VectorXd& p,
+                                                 double t_off, int order, double time_constant,
+                                                 const std::vector<double>& t, double floor_rel) {
+  std::vector<double> out;
+  if (t.empty() || !(time_constant > 0.0) || order < 1) return out;
+  const double t_max = std::max(t.back(), t_off);
+  double dg = time_constant / 8.0;
+  int ng = static_cast<int>(std::ceil((t_max - t_off) / dg)) + 2;
+  if (ng > 40000) ng = 40000, dg = (t_max - t_off) / (ng - 2);
+  std::vector<double> x(ng);
+  for (int k = 0; k < ng; ++k) {
+    const double la = ringdownLogAmplitude(law, p, t_off + k * dg, 0.0);
+    if (!std::isfinite(la)) return out;
+    x[k] = std::exp(la);
+  }
+  // n stages, each exact for an input linear between grid points, started on the plateau x[0].
+  const double a = std::exp(-dg / time_constant);
+  const double c = 1.0 - (time_constant / dg) * (1.0 - a);
+  for (int s = 0; s < order; ++s) {
+    double yk = x[0], xk = x[0];
+    for (int k = 1; k < ng; ++k) {
+      const double xn = x[k];
+      yk = a * yk + (1.0 - a) * xk + (xn - xk) * c;
+      xk = xn;
+      x[k] = yk;
+    }
+  }
+  out.resize(t.size());
+  Eigen::VectorXd q(2);
+  for (size_t i = 0; i < t.size(); ++i) {
+    double v = x[0];
+    if (t[i] > t_off) {
+      const double u = (t[i] - t_off) / dg;
+      const int k = std::min(ng - 2, static_cast<int>(u));
+      const double fr = u - k;
+      v = x[k] + fr * (x[k + 1] - x[k]);
+    }
+    if (!(v > 0.0)) return {};
+    q << std::log(v), 0.0;
+    out[i] = ringdownLogAmplitude("linear", q, 0.0, floor_rel);
+  }
+  return out;
+}
+
+RingdownFilteredFit fitRingdownThroughFilter(const RingdownEnvelope& env,
+                                             const RingdownSegment& seg, const RingdownFit& law_fit,
+                                             const RingdownDetectorFilter& filter,
+                                             const std::vector<double>& ar) {
+  RingdownFilteredFit out;
+  out.model = law_fit.model;
+  if (!filter.found || law_fit.t_s.empty()) return out;
+  const double ts = law_fit.t_scale_s, tr = law_fit.t_ref_s;
+  const double tf = filter.time_constant_s / ts;
+  const double t_lo = seg.has_plateau
+                          ? seg.drive_off_s - 12.0 * filter.order * filter.time_constant_s
+                          : -std::numeric_limits<double>::infinity();
+  std::vector<double> tt, yy, ww;
+  size_t j = 0;
+  for (size_t i = 0; i < seg.i_end && i < env.size(); ++i) {
+    if (env.t_s[i] < t_lo || seg.dropout[i] || !std::isfinite(env.log_amplitude[i])) continue;
+    while (j < law_fit.t_s.size() && law_fit.t_s[j] < env.t_s[i]) ++j;
+    const double w = j < law_fit.t_s.size() && law_fit.t_s[j] == env.t_s[i]
+                         ? law_fit.weight[j]
+                         : law_fit.weight.front();
+    tt.push_back((env.t_s[i] - tr) / ts);
+    yy.push_back(env.log_amplitude[i] - law_fit.log_a_ref);
+    ww.push_back(std::sqrt(w));
+  }
+  const int n = static_cast<int>(tt.size());
+  const int np = static_cast<int>(law_fit.p.size());
+  if (n < np + 10) return out;
+  auto res = [&](const Eigen::VectorXd& q, Eigen::VectorXd& r) {
+    const std::vector<double> f = ringdownFilteredLogAmplitude(
+        law_fit.model, q.head(np), q(np), filter.order, tf, tt, law_fit.floor_rel);
+    if (f.empty()) return false;
+    r.resize(n);
+    for (int i = 0; i < n; ++i) r(i) = ww[i] * (yy[i] - f[i]);
+    return r.allFinite();
+  };
+  const double off0 = ((seg.has_plateau ? seg.drive_off_s : env.t_s.front()) - tr) / ts;
+  double best = std::numeric_limits<double>::infinity();
+  for (double shift : {0.0, -1.0}) {
+    Eigen::VectorXd q(np + 1);
+    q.head(np) = law_fit.p;
+    q(np) = off0 + shift * filter.order * tf;
+    double sse = 0.0;
+    if (!minimize(res, q, sse)) continue;
+    if (sse < best) best = sse, out.p = q;
+  }
+  if (!std::isfinite(best)) return out;
+  out.ok = true;
+  out.sse_w = best;
+  out.n = n;
+  out.t_start_s = tt.front() * ts + tr;
+  out.drive_off_s = out.p(np) * ts + tr;
+  Eigen::VectorXd r;
+  res(out.p, r);
+  std::vector<double> e(r.data(), r.data() + r.size());
+  double s = 0.0;
+  for (double v : ringdownArWhiten(ar, e)) s += v * v;
+  out.sse_whitened = s;
+  return out;
+}
+
+}  // namespace cvg_bench
