@@ -61,6 +61,8 @@ std::vector<std::string> RingdownExplainOptions::validate() const {
   return out;
 }
 
+constexpr int kLackOfFitBlocks = 4;
+
 double ringdownLackOfFitP(const RingdownFit& fit) {
   const int n = fit.n, p = fit.n_params;
   if (n < p + 12) return 1.0;
@@ -86,23 +88,38 @@ double ringdownLackOfFitP(const RingdownFit& fit) {
     const double P5 = (63 * std::pow(x, 5) - 70 * x * x * x + 15 * x) / 8.0;
     X(i, p) = sw * P2, X(i, p + 1) = sw * P3, X(i, p + 2) = sw * P4, X(i, p + 3) = sw * P5;
   }
-  if (!X.allFinite()) return 1.0;
+  return ringdownAddedTermsP(X, r, q);
+}
+
+double ringdownAddedTermsP(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, int q) {
+  const int m = static_cast<int>(X.cols());
+  if (!X.allFinite() || !r.allFinite() || q < 1 || q >= m) return 1.0;
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(X);
-  if (qr.rank() < p + q) return 1.0;
+  if (qr.rank() < m) return 1.0;
   const Eigen::VectorXd b = qr.solve(r);
   const Eigen::VectorXd e = r - X * b;
-  const RingdownCovariance cov = ringdownCovariance(X, e, false);
   const Eigen::VectorXd bq = b.tail(q);
-  const Eigen::MatrixXd C = cov.covariance.bottomRightCorner(q, q);
-  const double w = bq.dot(C.colPivHouseholderQr().solve(bq));
-  return chi2Upper(q, w);
+  // Structure must be significant under both noise models: one AR model of the whole span, and
+  // AR models fitted block by block (the noise changes along a record: relative noise early, the
+  // detector's slow floor noise late). Either alone flags clean records where the other holds.
+  double p_value = 0.0;
+  for (int local = 0; local < 2; ++local) {
+    const RingdownCovariance cov =
+        local ? ringdownCovarianceLocalAr(X, e, kLackOfFitBlocks) : ringdownCovariance(X, e, false);
+    const Eigen::MatrixXd C = cov.covariance.bottomRightCorner(q, q);
+    const double w = bq.dot(C.colPivHouseholderQr().solve(bq));
+    if (!std::isfinite(w)) continue;  // no usable noise model: that one shows nothing
+    p_value = std::max(p_value, chi2Upper(q, w));
+  }
+  return p_value;
 }
 
 namespace {
 
 /// Blocked two-fold hold-out error of a model: the span's used samples in kHoldOutBlocks
-/// contiguous blocks, fitted on the even blocks and scored on the odd ones and back, started from
-/// the full fit. Returns the weighted squared prediction error over all samples (inf on failure).
+/// contiguous blocks, fitted on the even blocks and scored on the odd ones between them and back,
+/// started from the full fit. Returns the weighted squared prediction error over all samples (inf
+/// on failure).
 constexpr int kHoldOutBlocks = 48;
 double holdOutError(const RingdownEnvelope& env, const RingdownSegment& seg,
                     const RingdownFit& full, const RingdownFitOptions& base) {
@@ -124,7 +141,12 @@ double holdOutError(const RingdownEnvelope& env, const RingdownSegment& seg,
     } catch (const AnalysisError&) {
       return kInfinity;
     }
-    for (size_t k = 0; k < n; ++k) {
+    // Scored between the first and the last fitted sample only: predicting the block before the
+    // first fitted one extrapolates a fast first stage backwards, which says nothing of the fit.
+    size_t first = n, last = 0;
+    for (size_t k = 0; k < n; ++k)
+      if (!o.hold_out[used[k]]) first = std::min(first, k), last = k;
+    for (size_t k = first; k < last; ++k) {
       if (!o.hold_out[used[k]]) continue;
       const double e = full.log_amplitude[k] - ringdownPredict(f, full.t_s[k]);
       if (!std::isfinite(e)) return kInfinity;
@@ -371,7 +393,8 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
   x.lack_of_fit_p = ringdownLackOfFitP(x.final_fit);
   x.lack_of_fit_test =
       "Wald test of Legendre P2..P5 in time added to the final model's weighted residuals, "
-      "covariance under the residuals' AR noise model";
+      "significant under both the residuals' AR noise model and AR models fitted in 4 contiguous "
+      "blocks";
   const bool lof = x.lack_of_fit_p < options.alpha;
   x.unexplained = lof || (!pick && !negative_law.empty());
   bool negative = false;

@@ -328,11 +328,20 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
   } else if (!var_k.empty()) {
     s_m2 = var_k.front();
   }
+  // The floor measured past the span fixes the additive term: circular noise of rms F on an
+  // amplitude A >> F scatters ln A with variance F^2 / (2 A^2). The bin scatter above misses much
+  // of it when the detector's noise is correlated over a good part of a bin (the local quadratic
+  // follows the slow wander), which overweights the tail and narrows the intervals, so the
+  // floor's value is a lower bound on the bins' one.
+  const double s_a2_floor = 0.5 * fit.floor_rel * fit.floor_rel;
+  const bool floor_sets_noise = s_a2_floor > s_a2;
+  if (floor_sets_noise) s_a2 = s_a2_floor;
   const double lvl_low = lvl_k.empty() ? 0.0 : *std::min_element(lvl_k.begin(), lvl_k.end());
   const double add_low = s_a2 * std::exp(-2.0 * lvl_low);
-  const bool additive = options.error_model == "additive" ||
-                        (options.error_model == "auto" && add_low > 1.0 * s_m2 &&
-                         var_k.size() >= 2 && var_k.back() > 2.0 * var_k.front());
+  const bool additive =
+      options.error_model == "additive" ||
+      (options.error_model == "auto" && add_low > 1.0 * s_m2 &&
+       ((var_k.size() >= 2 && var_k.back() > 2.0 * var_k.front()) || s_a2_floor > 0.0));
   {
     std::ostringstream w;
     w.precision(3);
@@ -343,10 +352,18 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
       << " dB at the end of the span -> "
       << (additive ? "additive noise on the amplitude (sd grows as 1/A; floor in the model)"
                    : "noise on the log/dB scale (sd constant)");
+    if (additive && floor_sets_noise)
+      w << "; additive sd from the floor's rms (above the span's scatter, which correlated noise "
+           "understates)";
     fit.error_model = additive ? "additive" : "log";
     fit.error_model_why = w.str();
   }
   if (!additive) s_a2 = 0.0;
+  // Every record carries some relative (log-scale) noise: with the multiplicative term at zero
+  // the weights grow as A^2 and the first samples (a fast first stage, a corner) outweigh the
+  // rest of the decay by orders of magnitude. A quarter of the quietest bin's scatter bounds it.
+  if (additive && !var_k.empty())
+    s_m2 = std::max(s_m2, 0.25 * *std::min_element(var_k.begin(), var_k.end()));
   if (s_m2 <= 0.0 && s_a2 <= 0.0) s_m2 = 1.0;
   // Weights at a smoothed level (5-point running mean), fixed during the fit.
   for (int i = 0; i < n; ++i) {
@@ -362,6 +379,12 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
   // span instead: a weighted Legendre polynomial of degree 6 in time (leverage 7 / n per sample),
   // refitted once with its own weights. The same for every model, so criteria compare.
   if (additive && n > 40) {
+    const int half = std::max(10, n / 32);
+    Eigen::VectorXd y_lo(n), y_hi(n);
+    for (int i = 0; i < n; ++i) {
+      const int a = std::max(0, i - half), len = std::min(n - 1, i + half) - a + 1;
+      y_lo(i) = d.y.segment(a, len).minCoeff(), y_hi(i) = d.y.segment(a, len).maxCoeff();
+    }
     for (int pass = 0; pass < 2; ++pass) {
       const int deg = 6;
       Eigen::MatrixXd X(n, deg + 1);
@@ -378,7 +401,10 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
       }
       const Eigen::VectorXd c = X.colPivHouseholderQr().solve(Y);
       for (int i = 0; i < n; ++i) {
-        const double lvl = X.row(i).dot(c) / std::sqrt(d.w(i));
+        // Held within the observed levels nearby: a polynomial through a sharp corner (a fast
+        // first stage) overshoots, and a level far below the data gives a sample no weight.
+        const double lvl =
+            std::min(std::max(X.row(i).dot(c) / std::sqrt(d.w(i)), y_lo(i)), y_hi(i));
         d.w(i) = 1.0 / (s_m2 + s_a2 * std::exp(-2.0 * lvl));
       }
     }

@@ -208,6 +208,80 @@ RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen
 
 }  // namespace
 
+RingdownCovariance ringdownCovarianceLocalAr(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
+                                             int blocks) {
+  RingdownCovariance out = ringdownCovarianceModel(J, r);
+  const int n = static_cast<int>(J.rows()), p = static_cast<int>(J.cols());
+  const int B = std::max(1, std::min(blocks, n / 150));
+  if (out.rank < p || B < 2) return out;
+  // Per block: the variance and the autocorrelation of its own AR(p <= 12, BIC) model.
+  std::vector<double> var(B);
+  std::vector<std::vector<double>> rho(B);
+  std::vector<int> lo(B + 1);
+  for (int b = 0; b <= B; ++b) lo[b] = b * n / B;
+  for (int b = 0; b < B; ++b) {
+    const int m = lo[b + 1] - lo[b];
+    // Not centred: the block mean of slow noise is noise, not an offset to remove.
+    const Eigen::VectorXd x = r.segment(lo[b], m);
+    var[b] = x.squaredNorm() / m;
+    const int kmax = std::min(kMaxArOrder, m / 8);
+    int best_p = 0;
+    double best_bic = std::numeric_limits<double>::infinity();
+    for (int k = 0; k <= kmax; ++k) {
+      double v = 0.0;
+      fitAr(x.tail(m - (kmax - k)), k, v);
+      const double bic =
+          (m - kmax) * std::log(std::max(v, 1e-300)) + k * std::log(static_cast<double>(m - kmax));
+      if (bic < best_bic) best_bic = bic, best_p = k;
+    }
+    double innov = 0.0;
+    std::vector<double> a = fitAr(x, best_p, innov);
+    rho[b] = arAutocorrelation(a, m / 2);
+    // A least-squares AR fit may come out non-stationary (a step inside the block): shrink the
+    // coefficients until its autocorrelation is finite.
+    for (int shrink = 0; shrink < 40; ++shrink) {
+      bool finite = true;
+      for (double v : rho[b]) finite &= std::isfinite(v);
+      if (finite) break;
+      for (double& c : a) c *= 0.9;
+      rho[b] = arAutocorrelation(a, m / 2);
+    }
+    int L = 0;
+    for (int l = 1; l < static_cast<int>(rho[b].size()); ++l) {
+      if (std::fabs(rho[b][l]) < 1e-4) break;
+      L = l;
+    }
+    rho[b].resize(L + 1);
+  }
+  // Meat sum_b sum_{i,j in b} v_b rho_b(|i - j|) J_i J_j': block-diagonal, each block's
+  // covariance that of its own stationary AR model (positive semi-definite, as the sum is); the
+  // correlation across a block boundary (a few lags against hundreds of samples) is left out.
+  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(p, p);
+  for (int b = 0; b < B; ++b) {
+    const int m = lo[b + 1] - lo[b];
+    const auto Jb = J.middleRows(lo[b], m);
+    Eigen::MatrixXd mb = Jb.transpose() * Jb;
+    for (int l = 1; l < static_cast<int>(rho[b].size()) && l < m; ++l) {
+      const Eigen::MatrixXd c = Jb.topRows(m - l).transpose() * Jb.bottomRows(m - l);
+      mb += rho[b][l] * (c + c.transpose());
+    }
+    meat += var[b] * mb;
+  }
+  Eigen::HouseholderQR<Eigen::MatrixXd> hq(J);
+  const Eigen::MatrixXd R = hq.matrixQR().topRows(p).triangularView<Eigen::Upper>();
+  const Eigen::MatrixXd Rinv =
+      R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(p, p));
+  const Eigen::MatrixXd jtj_inv = Rinv * Rinv.transpose();
+  if (!meat.allFinite()) return ringdownCovarianceModel(J, r);
+  out.covariance = jtj_inv * meat * jtj_inv;
+  out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
+  std::ostringstream m;
+  m << "AR noise models fitted in " << B
+    << " contiguous blocks (variance and correlation may change along the record): sandwich";
+  out.method = m.str();
+  return out;
+}
+
 std::vector<double> ringdownArWhiten(const std::vector<double>& ar, const std::vector<double>& e) {
   const int p = static_cast<int>(ar.size()), n = static_cast<int>(e.size());
   std::vector<double> w(n);

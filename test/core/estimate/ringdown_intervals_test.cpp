@@ -84,5 +84,21 @@ TEST(RingdownIntervals, BlockCheckKeepsCoverageWhenTheCorrelationChanges) {
   EXPECT_LE(covered, static_cast<int>(0.99 * reps)) << "AR-model-only coverage " << covered_model;
 }
 
+// A step inside a block makes a least-squares AR fit explosive; the covariance stays finite.
+TEST(RingdownIntervals, LocalArCovarianceIsFiniteWithAStepInABlock) {
+  const int n = 1600;
+  Eigen::MatrixXd J(n, 2);
+  Eigen::VectorXd r(n);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g(0.0, 0.01);
+  for (int i = 0; i < n; ++i) {
+    J(i, 0) = 1.0, J(i, 1) = static_cast<double>(i) / n;
+    r(i) = (i > 1000 ? 1.0 : 0.0) + (i > 1000 ? 2e-3 * (i - 1000) : 0.0) + g(rng);
+  }
+  const RingdownCovariance c = ringdownCovarianceLocalAr(J, r, 4);
+  EXPECT_TRUE(c.covariance.allFinite());
+  EXPECT_GT(c.covariance(1, 1), 0.0);
+}
+
 }  // namespace
 }  // namespace cvg_bench

@@ -47,6 +47,14 @@ struct RingdownCovariance {
 RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& jacobian,
                                       const Eigen::VectorXd& residuals, bool block_check = true);
 
+/// Steps 1-3 with the noise model fitted separately in up to `blocks` contiguous blocks (at least
+/// 150 samples each): a block-diagonal noise covariance, each block's variance and AR(p <= 12,
+/// BIC) correlation its own. For the lack-of-fit test, whose covariance
+/// must hold where the noise changes along the record (relative noise early, the detector's slow
+/// floor noise late) without absorbing a misfit as the cluster sandwich would.
+RingdownCovariance ringdownCovarianceLocalAr(const Eigen::MatrixXd& jacobian,
+                                             const Eigen::VectorXd& residuals, int blocks = 4);
+
 /// One-step prediction errors of e under the stationary AR noise model a_1..a_p, in units of the
 /// innovation sd (generalized least squares): the first p samples are predicted from the ones
 /// before them only (Durbin-Levinson on the model's autocorrelation) and scaled by their larger
