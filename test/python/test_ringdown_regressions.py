@@ -1,0 +1,69 @@
+"""Ring-down records of the independent generator (scripts/validate_ringdown.py, tuning seeds only)
+on which earlier versions of `explain --mode ringdown` went wrong, with their known truth:
+- two_stage 42400014: a fast first stage 10x the mode at the first sample; the additive-noise
+  weights collapsed (no relative-noise term, levels from a polynomial overshooting the corner) and
+  the span's first samples outweighed the rest: a beat was called, with lack of fit;
+- clean 41000029: lock-in-filtered floor noise wandering over the span's last decibels; the span's
+  scatter understated it, the tail was overweighted and the record was called unexplained;
+- det_loss 42500020: a detection-gain step inside one block of the lack-of-fit test's local AR
+  models (their least-squares fit came out non-stationary): it must stay unexplained.
+Skipped when the tool is not built."""
+import importlib.util
+import json
+import os
+import subprocess
+import tempfile
+import unittest
+
+ROOT = os.path.abspath(os.environ.get("CVG_BENCH_ROOT",
+                                      os.path.join(os.path.dirname(__file__), "..", "..")))
+TOOL = os.path.join(ROOT, "bin", "cvg_ident")
+
+
+def generator():
+    spec = importlib.util.spec_from_file_location(
+        "validate_ringdown", os.path.join(ROOT, "scripts", "validate_ringdown.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@unittest.skipUnless(os.path.exists(os.path.join(ROOT, "build", "ws", "devel", "lib", "cvg_bench",
+                                                 "cvg_ident")), "tool not built")
+class RingdownRegressions(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.gen = generator()
+        cls.tmp = tempfile.mkdtemp()
+
+    def explain(self, kind, seed):
+        t, y, idx, fmt, truth = self.gen.make_record(kind, seed, True)
+        path = os.path.join(self.tmp, "%s_%d.csv" % (kind, seed))
+        self.gen.write_record(path, t, y, idx, fmt, truth)
+        out = path + ".json"
+        p = subprocess.run([TOOL, "explain", path, "--mode", "ringdown", "--json", out],
+                           capture_output=True, text=True)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        return json.load(open(out)), truth
+
+    def test_fast_first_stage_is_a_two_stage_decay(self):
+        j, _ = self.explain("two_stage", 42400014)
+        self.assertEqual(j["selected"], ["two_stage"], j["cause"])
+        self.assertFalse(j["unexplained"], j["cause"])
+
+    def test_clean_record_with_slow_floor_noise_is_a_single_exponential(self):
+        j, truth = self.explain("clean", 41000029)
+        self.assertEqual(j["selected"], [], j["cause"])
+        self.assertFalse(j["unexplained"], j["cause"])
+        q = j["final"]["derived_ci"]["Q"]
+        self.assertLessEqual(q["ci_low"], truth["Q"])
+        self.assertGreaterEqual(q["ci_high"], truth["Q"])
+        self.assertIn("floor's rms", j["final"]["error_model"]["why"])
+
+    def test_detection_step_stays_unexplained(self):
+        j, _ = self.explain("det_loss", 42500020)
+        self.assertTrue(j["unexplained"], j["cause"])
+
+
+if __name__ == "__main__":
+    unittest.main()
