@@ -14,5 +14,5 @@ mkdir -p build/validate/work
   --markdown docs/validation_independent.md --explain-doc docs/validation_explain.md \
   --coverage-doc docs/validation.md --work build/validate/work --json build/validate/last.json "$@"
 if [ -f scripts/validate_ringdown.py ]; then
-  /usr/bin/python3 scripts/validate_ringdown.py --n 60 --markdown docs/validation_ringdown.md
+  /usr/bin/python3 scripts/validate_ringdown.py --n 100 --markdown docs/validation_ringdown.md
 fi

@@ -21,12 +21,14 @@ floor, drop-outs, random frequency, Q, amplitude scale (1e-5 .. 10) and record l
   two_stage    an incoherent fast decay (1.5 .. 5 x the mode at switch-off, rate 5 .. 15 x)
   det_loss     a smooth 6 .. 12 dB step of the detection gain mid-decay (rate rises and falls)
 Thresholds (fixed before running): Q coverage of the 95 % interval in [0.90, 0.98]; each cause
-detected (the right name selected; det_loss: `unexplained`) in >= 95 %; false alarms on clean
-records (any extension selected or `unexplained`) <= 5 %; floor found in >= 95 % of records with a
-floor and claimed in <= 5 % without. Rates carry Wilson 95 % intervals. Tuning runs use other seed
-bases than the reporting run (`--seed-base`; the reporting base is the default, 93517331, first
-used after the detector-filter change was tuned on bases 41000000, 42000000 and 43000000;
-20261125, 30261125, 71829304 and 88412207 are spent). 60 records a class: a Wilson interval of +-0.06 at 0.95, enough to tell 0.90 from 0.98.
+detected (the right name selected; det_loss: `unexplained`) in >= 95 %; the right cause over all
+records (clean: nothing selected and not unexplained) in >= 95 %; false alarms on clean records
+(any extension selected or `unexplained`) <= 5 %; floor found in >= 95 % of records with a floor
+and claimed in <= 5 % without. Rates carry Wilson 95 % intervals. Tuning runs use other seed bases
+than the reporting run (`--seed-base`; the reporting base is the default, 96204411, first used
+after the noise-model changes of 26 Nov were tuned on bases 41000000 and 42000000 and checked on
+43000000; 20261125, 30261125, 71829304, 88412207 and 93517331 are spent). 100 records a class: a
+Wilson interval of about +-0.05 at 0.95.
 
 Usage: validate_ringdown.py [--markdown FILE] [--n N] [--seed-base S] [--classes a,b] [--jobs J]
 """
@@ -474,8 +476,8 @@ def covered(v, truth):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--markdown")
-    ap.add_argument("--n", type=int, default=60, help="records per class")
-    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=93517331,
+    ap.add_argument("--n", type=int, default=100, help="records per class")
+    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=96204411,
                     help="first seed (the reporting run uses the default; tune on others)")
     ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated subset")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("VALIDATE_JOBS", "2")))
@@ -536,6 +538,19 @@ def main():
         rate_row("%s detected (selected = [%s])" % (kind, kind), k, len(by[kind]), DETECTION_MIN)
     k = sum(r["rc"] == 0 and r["json"]["unexplained"] for r in by["det_loss"])
     rate_row("detection loss flagged unexplained", k, len(by["det_loss"]), DETECTION_MIN)
+    # The issue's criterion over every record: the right cause (a clean record: no extension and
+    # not unexplained; a cause: selected = [it]; a detection loss: unexplained).
+    def right(r):
+        if r["rc"] != 0:
+            return False
+        j = r["json"]
+        if r["kind"] == "clean":
+            return not j["selected"] and not j["unexplained"]
+        if r["kind"] == "det_loss":
+            return bool(j["unexplained"])
+        return j["selected"] == [r["kind"]]
+    rate_row("correct cause, all classes", sum(right(r) for r in results), len(results),
+             DETECTION_MIN)
     withf = [r for r in results if r["floor"] and r["rc"] == 0 and r["kind"] == "clean"]
     nof = [r for r in results if not r["floor"] and r["rc"] == 0]
     rate_row("noise floor found (clean, with floor)",
