@@ -25,9 +25,10 @@ detected (the right name selected; det_loss: `unexplained`) in >= 95 %; the righ
 records (clean: nothing selected and not unexplained) in >= 95 %; false alarms on clean records
 (any extension selected or `unexplained`) <= 5 %; floor found in >= 95 % of records with a floor
 and claimed in <= 5 % without. Rates carry Wilson 95 % intervals. Tuning runs use other seed bases
-than the reporting run (`--seed-base`; the reporting base is the default, 96204411, first used
-after the noise-model changes of 26 Nov were tuned on bases 41000000 and 42000000 and checked on
-43000000; 20261125, 30261125, 71829304, 88412207 and 93517331 are spent). 100 records a class: a
+than the reporting run (`--seed-base`; the reporting base is the default, 97308523, first used
+after the noise-model changes of 26 Nov and the span's stop above a floor the decay only bends
+towards were tuned on bases 41000000 and 42000000 and checked on 43000000; 20261125, 30261125,
+71829304, 88412207, 93517331 and 96204411 are spent). 100 records a class: a
 Wilson interval of about +-0.05 at 0.95.
 
 Usage: validate_ringdown.py [--markdown FILE] [--n N] [--seed-base S] [--classes a,b] [--jobs J]
@@ -516,7 +517,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--markdown")
     ap.add_argument("--n", type=int, default=100, help="records per class")
-    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=96204411,
+    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=97308523,
                     help="first seed (the reporting run uses the default; tune on others)")
     ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated subset")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("VALIDATE_JOBS", "2")))

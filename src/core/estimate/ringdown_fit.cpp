@@ -266,7 +266,11 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
       first.push_back(env.log_amplitude[used[i]]);
     fit.log_a_ref = median(first);
   }
-  fit.floor_rel = seg.has_floor ? std::exp(seg.floor_log_amplitude - fit.log_a_ref) : 0.0;
+  // A floor the decay only bends towards counts for the model and the noise as a confirmed one.
+  fit.floor_rel = seg.has_floor ? std::exp(seg.floor_log_amplitude - fit.log_a_ref)
+                  : std::isfinite(seg.suspected_floor_log_amplitude)
+                      ? std::exp(seg.suspected_floor_log_amplitude - fit.log_a_ref)
+                      : 0.0;
   if (!options.hold_out.empty()) {
     if (options.hold_out.size() != env.size())
       throw InputError("ring-down fit: hold_out has " + std::to_string(options.hold_out.size()) +

@@ -206,6 +206,20 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
         b > a + 4) {
       const FloorFit ff = fitFloor(t, y, seg.dropout, a, tail_level);
       const double excess = ff.floor_log - ff.line_end;
+      if (ff.ok && ff.slope < 0.0 &&
+          !(ff.evidence > kFloorEvidence && excess > kFloorExcessDb / kDbPerNeper) &&
+          excess > 0.0) {
+        // Not confirmed as a floor, but the best line-plus-floor puts one above the line's end:
+        // a record that ends in the bend towards its floor. The span stops the margin above that
+        // level all the same (no floor is claimed; the fit below it would bend without a model).
+        seg.suspected_floor_log_amplitude = ff.floor_log;
+        const double cut = ff.floor_log + options.floor_margin_db / kDbPerNeper;
+        for (size_t i = i_peak; i < n; ++i)
+          if (std::isfinite(sm[i]) && sm[i] <= cut) {
+            i_end = i;
+            break;
+          }
+      }
       if (ff.ok && ff.slope < 0.0 && ff.evidence > kFloorEvidence &&
           excess > kFloorExcessDb / kDbPerNeper) {
         const double floor_log = ff.floor_log;
@@ -335,6 +349,11 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     why << "; floor " << seg.floor_log_amplitude * kDbPerNeper << unit << " from "
         << seg.floor_start_s << " s, fit ends " << options.floor_margin_db << " dB above it at "
         << seg.t_end_s << " s";
+  else if (std::isfinite(seg.suspected_floor_log_amplitude))
+    why << "; the decay bends towards a floor near "
+        << seg.suspected_floor_log_amplitude * kDbPerNeper << unit
+        << " (too little of it in the record to confirm one): fit ends " << options.floor_margin_db
+        << " dB above that level at " << seg.t_end_s << " s";
   else
     why << "; no noise floor reached (decay to the end, " << seg.t_end_s << " s)";
   why << "; " << seg.n_dropouts_in_span << " drop-outs left out of " << (i_end - i_start)

@@ -19,6 +19,7 @@
 //  4. Refusal: under 3 dB (or 10 robust sd) of decay, or under 8 samples in the span.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -45,7 +46,10 @@ struct RingdownSegment {
   bool has_floor = false;
   double floor_log_amplitude = 0.0;  ///< ln of the floor's rms amplitude (when has_floor)
   double floor_start_s = 0.0;        ///< where the envelope reaches the floor (when has_floor)
-  std::vector<bool> dropout;         ///< per envelope sample
+  /// ln of a floor the decay bends towards but the record holds too little of to confirm (NaN
+  /// when none); the span stops the margin above it without claiming a floor.
+  double suspected_floor_log_amplitude = std::numeric_limits<double>::quiet_NaN();
+  std::vector<bool> dropout;  ///< per envelope sample
   size_t n_dropouts_in_span = 0;
   size_t n_used = 0;          ///< samples in the span that are not drop-outs
   double decay_db = 0.0;      ///< drop of the running median over the span [dB]
