@@ -55,6 +55,28 @@ TEST(RingdownFit, PlateauFloorAndDropOutsAreSegmentedAndQIsRecovered) {
   EXPECT_TRUE(f.flags.empty());
 }
 
+// A record that ends 5 dB below the floor's level: too little floor to confirm one, but the line
+// plus floor puts it above the line's end; the span stops 10 dB above it instead of running into
+// the bend (where the main branch fitted to the end of the record).
+TEST(RingdownFit, RecordEndingInTheBendToItsFloorStopsAboveIt) {
+  RingdownSimulationOptions o = bench();
+  o.plateau_s = 2.0;
+  o.duration_s = 48.0;  // tau = 6.37 s: -60 dB at 44 s after the switch-off, the end at -65 dB
+  o.noise_correlation = 0.5;
+  o.dropouts = 0;
+  RingdownSegment seg;
+  const RingdownFit f = fitOf(simulateRingdown(o), &seg);
+  const double tau = o.q / (M_PI * o.frequency_hz);
+  EXPECT_FALSE(seg.has_floor);
+  ASSERT_TRUE(std::isfinite(seg.suspected_floor_log_amplitude));
+  EXPECT_NEAR(seg.suspected_floor_log_amplitude * 20 / std::log(10.0), -60.0, 2.0);
+  EXPECT_NEAR(seg.t_end_s - seg.drive_off_s, tau * std::log(1000.0 / std::sqrt(10.0)), 0.15 * tau);
+  EXPECT_NE(seg.why.find("bends towards a floor"), std::string::npos) << seg.why;
+  const RingdownValue& q = f.derived.at("Q");
+  EXPECT_GT(o.q, q.ci_low - 1.0 * q.std);
+  EXPECT_LT(o.q, q.ci_high + 1.0 * q.std);
+}
+
 TEST(RingdownFit, ScaleFreeAndDbInputGiveTheSameQ) {
   RingdownSimulationOptions o = bench();
   const RingdownFit f1 = fitOf(simulateRingdown(o));
