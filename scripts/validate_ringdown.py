@@ -102,6 +102,17 @@ single exponential with lack of fit). Check on base 43000000 (30 a class, used f
 170 -> 176 of 180 (beat 26 -> 29, two_stage 26 -> 29; 7 records wrong -> right, 2 right -> wrong:
 gamma_nl 43100005 now called gamma_a, two_stage 43400023 now a single exponential).
 
+5. **A record that ends in the bend towards its floor** (found after the run on base 96204411:
+   both clean false alarms there, 15 of the 22 detected beats without a found floor flagged
+   `unexplained` against 14 of 73 with one). The straight-line-plus-floor test needs a stretch of
+   floor to confirm one; when the record ends a few dB below the floor's level it finds none, the
+   span runs into the bend and a two-stage decay or lack of fit is called. Now, when the best line
+   plus floor puts a floor above the line's end without confirming it, the span stops 10 dB above
+   that level and the model and the noise bound use it; no floor is claimed (the printout says
+   "the decay bends towards a floor near ..."). Tuning 41000000/42000000: 353 -> 356 of 360 (beats
+   2, two_stage 1; 0 right -> wrong), beats flagged `unexplained` 11 -> 6 of 60; base 43000000:
+   176 -> 176. Known-answer test: RingdownFit.RecordEndingInTheBendToItsFloorStopsAboveIt.
+
 ## Detector filter and the amplitude laws (the previous run's change, base 93517331)
 
 The previous reporting run (base 88412207) missed gamma_nl in 11 of 60 records, 9 of them called
@@ -150,21 +161,21 @@ new step does not touch). Time per record rose by about 0.5 s (median 1.9 s here
 
 ## Before / after
 
-Before: the previous reporting run, base 93517331, 60 a class, the tool before the noise-model
-changes: Q coverage 53/60 (0.883), clean false alarms 5/60 (0.083), gamma_nl 54/60 (0.900),
-gamma_a 59/60, beat 57/60, two_stage 55/60 (0.917), detection loss 60/60, floor found 42/42,
-floor claimed without one 0/18; the right cause over all records 340/360 (0.944 [0.915, 0.964]).
-After: the tables above (fresh base 96204411, committed before its one run, 100 a class,
-thresholds unchanged; the all-records row was added before the run). Q coverage (0.940), clean
-false alarms (2/100: a two-stage call and one `unexplained`), beat (0.95), detection loss and the
-right cause over all records (575/600 = 0.958 [0.939, 0.972]) meet their targets; gamma_nl
-(0.94: 4 called gamma_a, 1 two_stage, 1 no extension) and two_stage (0.91: 3 single exponentials,
-two of them rejected by the hold-out check at 0.92 and 0.90 of the rival's error against the
-0.90 required; 3 beats; 2 gamma_nl; 1 unexplained) miss 0.95, and the floor was found in 66 of 70
-clean records with one (the segmentation is unchanged: the 4 are floors the straight-line-plus-
-floor test did not see). 29 of the 95 detected beats also carry `unexplained` (14 of 57 on the
-previous base). Run time: 600 records in 342 s wall with 2 jobs (median 0.97 s a record, max
-2.6 s; the machine was otherwise idle).
+Before: the reporting run on base 93517331 (60 a class, the tool before this session): Q coverage
+53/60 (0.883), clean false alarms 5/60 (0.083), gamma_nl 54/60 (0.900), gamma_a 59/60, beat 57/60,
+two_stage 55/60 (0.917), detection loss 60/60, floor found 42/42, floor claimed without one 0/18;
+the right cause over all records 340/360 (0.944 [0.916, 0.964]).
+Middle: base 96204411 (100 a class, changes 1-4): Q coverage 94/100, clean false alarms 2/100,
+gamma_nl 94, gamma_a 98, beat 95, two_stage 91, detection loss 99, floor found 66/70, claimed 0/30;
+the right cause over all records 575/600 (0.958 [0.939, 0.972]); 29 of 95 detected beats also
+`unexplained`. Change 5 was made after reading that run, so a new base was drawn for it.
+After: the tables above (base 97308523, committed before its one run, 100 a class, thresholds
+unchanged; the all-records row was added before the run on 96204411). Every row but two meets its
+target: two_stage 94/100 (3 single exponentials, 1 unexplained, 1 gamma_a, 1 beat) and floor found
+64/70 (the confirmation test is unchanged; records that end in the bend are now handled without
+claiming a floor, so they count as not found). The right cause over all 600 records: 587 (0.978
+[0.963, 0.987]); clean false alarms 0/100; 23 of the 100 detected beats also carry `unexplained`.
+Run time: 600 records in 509 s wall with 2 jobs beside a build (median 1.5 s a record, max 7.3 s).
 
 Earlier: base 71829304 (20 a class) gave Q coverage 19/20, clean false alarms 1/20, gamma_nl 16/20,
 gamma_a 20/20, beat 18/20, two_stage 18/20, detection loss 20/20, floor found 13/14.
