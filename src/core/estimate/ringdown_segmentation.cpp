@@ -17,6 +17,14 @@ constexpr double kDbPerNeper = 20.0 / 2.302585092994046;  // 20 / ln 10
 /// [dB], and the floor model beats the straight line by this evidence (n ln(SSE_0 / SSE_1)).
 constexpr double kFloorExcessDb = 3.0;
 constexpr double kFloorEvidence = 30.0;
+/// A noise floor scatters: ln of the Rayleigh amplitude of noise alone has sd pi / sqrt(24) = 0.64;
+/// past the line's crossing of the floor the scatter of ln A about a straight line must exceed
+/// this [neper] (1.7 dB), else the bend is a slowing decay (a damping law in A, the slower mode of
+/// two, a detection change), not a floor.
+constexpr double kFloorScatter = 0.2;
+/// Without the evidence, a floor also confirms when that scatter is this many times the one over
+/// the first half of the decay before the crossing (the signal's own noise).
+constexpr double kFloorScatterRatio = 2.0;
 
 double median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
@@ -44,7 +52,23 @@ struct FloorFit {
   double line_end = 0.0;   ///< the decay's straight continuation at the record's end (ln A)
   double slope = 0.0;      ///< [1/s] of ln A
   double evidence = 0.0;   ///< n ln(SSE_line / SSE_floor)
+  double tail_sd = std::numeric_limits<double>::quiet_NaN();  ///< scatter past the crossing
+  double head_sd = std::numeric_limits<double>::quiet_NaN();  ///< scatter over the early decay
 };
+
+/// Residual sd of a straight line fitted to (u, v) over u in [lo, hi); NaN under 10 points.
+double lineScatter(const std::vector<double>& u, const std::vector<double>& v, double lo,
+                   double hi) {
+  std::vector<int> k;
+  for (size_t i = 0; i < u.size(); ++i)
+    if (u[i] >= lo && u[i] < hi) k.push_back(static_cast<int>(i));
+  if (k.size() < 10) return std::numeric_limits<double>::quiet_NaN();
+  Eigen::MatrixXd X(k.size(), 2);
+  Eigen::VectorXd Y(k.size());
+  for (size_t i = 0; i < k.size(); ++i) X(i, 0) = 1.0, X(i, 1) = u[k[i]], Y(i) = v[k[i]];
+  const Eigen::VectorXd c = X.colPivHouseholderQr().solve(Y);
+  return std::sqrt((Y - X * c).squaredNorm() / static_cast<double>(k.size() - 2));
+}
 
 /// Fits ln A from sample a to the end with a straight decay plus an additive floor (the Rice mean
 /// of ringdown_models.h) and with the straight decay alone, by Gauss-Newton on at most 600
@@ -73,36 +97,52 @@ FloorFit fitFloor(const std::vector<double>& t, const std::vector<double>& y,
       r(i) = v[i] - ringdownLogAmplitude("linear", q, u[i], std::exp(p(2)));
     return r.allFinite();
   };
-  Eigen::Vector3d p(line(0), line(1), 0.2);  // floor near the tail's level
-  Eigen::VectorXd r, rp;
-  if (!resid(p, r)) return out;
-  double sse = r.squaredNorm();
-  for (int it = 0; it < 40; ++it) {
-    Eigen::MatrixXd J(m, 3);
-    for (int k = 0; k < 3; ++k) {
-      Eigen::Vector3d pp = p;
-      pp(k) += 1e-6;
-      if (!resid(pp, rp)) return out;
-      J.col(k) = (r - rp) / 1e-6;
-    }
-    const Eigen::Vector3d step = J.colPivHouseholderQr().solve(r);
-    double lam = 1.0;
-    bool moved = false, done = false;
-    for (int h = 0; h < 12 && !moved; ++h, lam *= 0.5) {
-      Eigen::Vector3d pn = p + lam * step;
-      pn(2) = std::max(pn(2), -20.0);
-      if (resid(pn, rp) && rp.squaredNorm() < sse) {
-        done = (sse - rp.squaredNorm()) / sse < 1e-9;
-        p = pn, r = rp, sse = rp.squaredNorm(), moved = true;
+  // Gauss-Newton from a floor near, above and below the tail's level; the lowest SSE wins.
+  Eigen::Vector3d p_best(line(0), line(1), 0.2);
+  double sse_best = std::numeric_limits<double>::infinity();
+  for (const double start : {0.2, 0.8, -0.5}) {
+    Eigen::Vector3d p(line(0), line(1), start);
+    Eigen::VectorXd r, rp;
+    if (!resid(p, r)) continue;
+    double sse = r.squaredNorm();
+    bool failed = false;
+    for (int it = 0; it < 40 && !failed; ++it) {
+      Eigen::MatrixXd J(m, 3);
+      for (int k = 0; k < 3 && !failed; ++k) {
+        Eigen::Vector3d pp = p;
+        pp(k) += 1e-6;
+        failed = !resid(pp, rp);
+        J.col(k) = (r - rp) / 1e-6;
       }
+      if (failed) break;
+      const Eigen::Vector3d step = J.colPivHouseholderQr().solve(r);
+      double lam = 1.0;
+      bool moved = false, done = false;
+      for (int h = 0; h < 12 && !moved; ++h, lam *= 0.5) {
+        Eigen::Vector3d pn = p + lam * step;
+        pn(2) = std::max(pn(2), -20.0);
+        if (resid(pn, rp) && rp.squaredNorm() < sse) {
+          done = (sse - rp.squaredNorm()) / sse < 1e-9;
+          p = pn, r = rp, sse = rp.squaredNorm(), moved = true;
+        }
+      }
+      if (!moved || done) break;
     }
-    if (!moved || done) break;
+    if (!failed && sse < sse_best) sse_best = sse, p_best = p;
   }
+  if (!std::isfinite(sse_best)) return out;
+  const Eigen::Vector3d& p = p_best;
   out.ok = true;
   out.floor_log = ref + p(2);
   out.slope = -p(1) / ts;
   out.line_end = ref + p(0) - p(1);
-  out.evidence = m * std::log(std::max(sse0, 1e-300) / std::max(sse, 1e-300));
+  out.evidence = m * std::log(std::max(sse0, 1e-300) / std::max(sse_best, 1e-300));
+  // Scatter past the line's crossing of the floor, and over the first half before it.
+  if (p(1) > 0.0) {
+    const double u_cross = (p(0) - p(2)) / p(1);
+    out.tail_sd = lineScatter(u, v, u_cross, 2.0);
+    out.head_sd = lineScatter(u, v, -1.0, 0.5 * std::min(u_cross, 1.0));
+  }
   return out;
 }
 
@@ -206,9 +246,11 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
         b > a + 4) {
       const FloorFit ff = fitFloor(t, y, seg.dropout, a, tail_level);
       const double excess = ff.floor_log - ff.line_end;
-      if (ff.ok && ff.slope < 0.0 &&
-          !(ff.evidence > kFloorEvidence && excess > kFloorExcessDb / kDbPerNeper) &&
-          excess > 0.0) {
+      const bool scatters = ff.tail_sd > kFloorScatter;  // false when NaN
+      const bool confirmed =
+          ff.ok && ff.slope < 0.0 && excess > kFloorExcessDb / kDbPerNeper && scatters &&
+          (ff.evidence > kFloorEvidence || ff.tail_sd > kFloorScatterRatio * ff.head_sd);
+      if (ff.ok && ff.slope < 0.0 && !confirmed && excess > 0.0 && scatters) {
         // Not confirmed as a floor, but the best line-plus-floor puts one above the line's end:
         // a record that ends in the bend towards its floor. The span stops the margin above that
         // level all the same (no floor is claimed; the fit below it would bend without a model).
@@ -220,8 +262,7 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
             break;
           }
       }
-      if (ff.ok && ff.slope < 0.0 && ff.evidence > kFloorEvidence &&
-          excess > kFloorExcessDb / kDbPerNeper) {
+      if (confirmed) {
         const double floor_log = ff.floor_log;
         seg.has_floor = true;
         seg.floor_log_amplitude = floor_log;

@@ -4,9 +4,14 @@
 //     median of their neighbours (a detector that lost lock, a spectrum-analyser blank).
 //  2. Noise floor: from 25 dB above the median level of the record's last tenth to the end, a
 //     straight ln A decay plus an additive floor (the Rice mean of ringdown_models.h) is fitted
-//     against the straight decay alone; a floor when it wins (n ln(SSE ratio) > 30) and lies 3 dB
-//     or more above the line's continuation at the end. The decay span ends where the running
-//     median falls to `floor_margin_db` above the floor (the fit includes the floor).
+//     against the straight decay alone. A floor lies 3 dB or more above the line's continuation
+//     at the end and scatters like noise past the line's crossing of it (sd of ln A about a line
+//     over 0.2, where Rayleigh noise alone gives 0.64), and either wins (n ln(SSE ratio) > 30) or
+//     scatters twice as much as the early decay. The decay span ends where the running median
+//     falls to `floor_margin_db` above the floor (the fit includes the floor). A floor above the
+//     continuation that scatters but is not confirmed is only suspected: the span stops the margin
+//     above it and no floor is claimed. A decay that slows without that scatter (a damping law in
+//     A, the slower of two modes) is no floor.
 //  3. Drive switch-off: the plateau level is the median of the smoothed envelope over the first
 //     twentieth; the decay starts where the envelope first falls max(6 sd, 0.1 dB) below its 5th
 //     percentile there (a beating plateau dips below its median). A
