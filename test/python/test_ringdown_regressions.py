@@ -13,7 +13,12 @@ on which earlier versions of `explain --mode ringdown` went wrong, with their kn
 - gamma_a 41200000 and det_loss 42500015 without a floor: a decay that slows (damping in A) or
   a detection step bent the line-plus-floor fit towards a level near the end; the span was cut
   10 dB above a suspected floor, and the detection step was called a floor. Neither scatters like
-  noise: no floor may be claimed or suspected.
+  noise: no floor may be claimed or suspected;
+- two_stage 41400082: a plateau shorter than the head the plateau level is read from; the decay
+  samples in it put the drive-off 3 dB into a 12 dB fast first stage, the span skipped the rest
+  of it and a single exponential was called;
+- beat 41300004: a plateau that beats less than once before the drive-off; the drive-off must stay
+  at the real switch-off (not at the plateau's first beat dip) and the beat be found.
 Skipped when the tool is not built."""
 import importlib.util
 import json
@@ -90,6 +95,16 @@ class RingdownRegressions(unittest.TestCase):
         j, _ = self.explain("det_loss", 42500015, with_floor=False)
         self.assertNotIn("noise_floor", j["causes"], j["final"]["segment"]["why"])
         self.assertTrue(j["unexplained"], j["cause"])
+
+    def test_short_plateau_keeps_the_fast_first_stage(self):
+        j, _ = self.explain("two_stage", 41400082)
+        self.assertEqual(j["selected"], ["two_stage"], j["cause"])
+        self.assertLess(j["final"]["segment"]["drive_off_s"], 9.0, j["final"]["segment"]["why"])
+
+    def test_slowly_beating_plateau_is_a_beat(self):
+        j, _ = self.explain("beat", 41300004)
+        self.assertTrue(j["final"]["segment"]["has_plateau"], j["final"]["segment"]["why"])
+        self.assertEqual(j["selected"], ["beat"], j["cause"])
 
 
 if __name__ == "__main__":

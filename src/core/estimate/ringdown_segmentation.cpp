@@ -288,21 +288,42 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
   // twentieth (a running median keeps the corner sharp); the decay starts where the envelope first
   // falls delta = max(6 sd, 0.1 dB) below it. A plateau exists when that crossing comes later than
   // three times the time the decay takes to fall by delta.
+  const size_t n_head = std::min(n, std::max<size_t>(5, n / 20));
   std::vector<double> head;
-  for (size_t i = 0; i < std::max<size_t>(5, n / 20) && i < n; ++i)
+  for (size_t i = 0; i < n_head; ++i)
     if (std::isfinite(sm[i])) head.push_back(sm[i]);
   const double c0 = median(head);
+  const double delta = std::max(6.0 * seg.noise_sd_log, 0.1 / kDbPerNeper);
   // The crossing is taken below the head's 5th percentile: a plateau that beats (two close modes
   // driven together) dips below its median every beat period.
-  std::sort(head.begin(), head.end());
-  const double c_low = head.empty() ? c0 : head[head.size() / 20];
-  const double delta = std::max(6.0 * seg.noise_sd_log, 0.1 / kDbPerNeper);
-  size_t i_cross = 0;
-  for (size_t i = 0; i < i_end; ++i)
-    if (std::isfinite(sm[i]) && sm[i] < c_low - delta) {
-      i_cross = i;
-      break;
-    }
+  auto crossing = [&](size_t upto, double* level) {
+    std::vector<double> h;
+    for (size_t i = 0; i < upto; ++i)
+      if (std::isfinite(sm[i])) h.push_back(sm[i]);
+    std::sort(h.begin(), h.end());
+    *level = h.empty() ? c0 : h[h.size() / 20];
+    for (size_t i = 0; i < i_end; ++i)
+      if (std::isfinite(sm[i]) && sm[i] < *level - delta) return i;
+    return size_t{0};
+  };
+  double c_low = c0;
+  size_t i_cross = crossing(n_head, &c_low);
+  // A plateau shorter than the head is followed by decay samples that lower that percentile (the
+  // drive-off then lands up to 3 dB into the decay and the span past a fast first stage). The head
+  // up to its last sample at or above the median gives an earlier crossing; it is taken when the
+  // envelope does not come back above that level before the first crossing (a beating plateau
+  // does).
+  {
+    size_t last_up = 0;
+    for (size_t i = 0; i < n_head; ++i)
+      if (std::isfinite(sm[i]) && sm[i] >= c0) last_up = i;
+    double c_short = c0;
+    const size_t i_short = crossing(last_up + 1, &c_short);
+    bool back = false;
+    for (size_t i = i_short; i < i_cross && !back; ++i)
+      back = std::isfinite(sm[i]) && sm[i] >= c_short;
+    if (i_short < i_cross && !back) i_cross = i_short, c_low = c_short;
+  }
   const size_t m_after = std::min(i_end, i_cross + std::max<size_t>(8, n / 20));
   const double s_after = -slopeOver(t, sm, seg.dropout, i_cross, m_after);
   // A plateau does not fall steadily at 0.3 or more of the rate after the crossing (a record that

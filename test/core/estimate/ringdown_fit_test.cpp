@@ -77,6 +77,24 @@ TEST(RingdownFit, RecordEndingInTheBendToItsFloorStopsAboveIt) {
   EXPECT_LT(o.q, q.ci_high + 1.0 * q.std);
 }
 
+// A plateau shorter than the first twentieth of the record (the head the plateau level is taken
+// from): the decay samples in the head must not lower the level the crossing is taken against,
+// which put the drive-off about 1.5 dB (1.1 s here) into the decay and the span past a fast first
+// stage.
+TEST(RingdownFit, ShortPlateauKeepsTheDriveOff) {
+  RingdownSimulationOptions o = bench();
+  o.duration_s = 60.0;
+  o.plateau_s = 1.8;  // 3 % of the record; the head is 5 %
+  o.dropouts = 0;
+  RingdownSegment seg;
+  const RingdownFit f = fitOf(simulateRingdown(o), &seg);
+  EXPECT_TRUE(seg.has_plateau) << seg.why;
+  EXPECT_NEAR(seg.drive_off_s, o.plateau_s, 0.3) << seg.why;
+  const RingdownValue& q = f.derived.at("Q");
+  EXPECT_GT(o.q, q.ci_low - 1.0 * q.std);
+  EXPECT_LT(o.q, q.ci_high + 1.0 * q.std);
+}
+
 TEST(RingdownFit, ScaleFreeAndDbInputGiveTheSameQ) {
   RingdownSimulationOptions o = bench();
   const RingdownFit f1 = fitOf(simulateRingdown(o));
