@@ -20,16 +20,19 @@ floor, drop-outs, random frequency, Q, amplitude scale (1e-5 .. 10) and record l
                0.15 .. 0.5 of the first, its Q 0.6 .. 1.6 x)
   two_stage    an incoherent fast decay (1.5 .. 5 x the mode at switch-off, rate 5 .. 15 x)
   det_loss     a smooth 6 .. 12 dB step of the detection gain mid-decay (rate rises and falls)
+Each cause class also has n / 5 records without a floor (decay to the end; seeds base + 50000 ..).
 Thresholds (fixed before running): Q coverage of the 95 % interval in [0.90, 0.98]; each cause
 detected (the right name selected; det_loss: `unexplained`) in >= 95 %; the right cause over all
 records (clean: nothing selected and not unexplained) in >= 95 %; false alarms on clean records
-(any extension selected or `unexplained`) <= 5 %; floor found in >= 95 % of records with a floor
-and claimed in <= 5 % without. Rates carry Wilson 95 % intervals. Tuning runs use other seed bases
-than the reporting run (`--seed-base`; the reporting base is the default, 97308523, first used
-after the noise-model changes of 26 Nov and the span's stop above a floor the decay only bends
-towards were tuned on bases 41000000 and 42000000 and checked on 43000000; 20261125, 30261125,
-71829304, 88412207, 93517331 and 96204411 are spent). 100 records a class: a
-Wilson interval of about +-0.05 at 0.95.
+(any extension selected or `unexplained`) <= 5 %; floor found in >= 95 % of clean records with a
+floor and claimed in <= 5 % of the records without one (every class); the right cause in >= 95 % of
+the causes' records without a floor (these rows were added before the run on base 98106237).
+Rates carry Wilson 95 % intervals. Tuning runs use other seed bases than the reporting run
+(`--seed-base`; the reporting base is the default, 98106237, first used after the floor test and
+the short plateau's drive-off of 26 Nov (third session) were tuned on bases 41000000 and 42000000
+(and further seeds of them); 20261125, 30261125, 71829304,
+88412207, 93517331, 96204411 and 97308523 are spent). 100 records a class (and 20 without a floor
+for each cause): a Wilson interval of about +-0.05 at 0.95.
 
 Usage: validate_ringdown.py [--markdown FILE] [--n N] [--seed-base S] [--classes a,b] [--jobs J]
 """
@@ -112,6 +115,39 @@ gamma_nl 43100005 now called gamma_a, two_stage 43400023 now a single exponentia
    "the decay bends towards a floor near ..."). Tuning 41000000/42000000: 353 -> 356 of 360 (beats
    2, two_stage 1; 0 right -> wrong), beats flagged `unexplained` 11 -> 6 of 60; base 43000000:
    176 -> 176. Known-answer test: RingdownFit.RecordEndingInTheBendToItsFloorStopsAboveIt.
+6. **A floor must scatter like noise** (26 Nov, third session). The floor test missed 6 of 70 clean
+   floors on base 97308523 and, on no-floor variants of the causes (tuning seeds 41/42 000000, 20
+   a class, with_floor off; the harness had none), called 4 of 40 detection steps and 4 of 40
+   beats floors and cut the span above a "suspected" floor on 30 of 40 gamma_a records: a decay
+   that slows (damping in A, the slower of two modes, a gain step) bends the line-plus-floor fit
+   just as a floor does. What tells them apart is the scatter past the line's crossing of the
+   floor: ln of noise alone (Rayleigh) has sd pi / sqrt(24) = 0.64 Np; on tuning floors 0.38 ..
+   0.79, on the slowing decays 0.01 .. 0.11 (beats up to 0.59). A floor now needs that scatter
+   over 0.2 Np, 3 dB above the line's end as before, and either the old evidence (> 30) or twice
+   the early decay's scatter (the evidence alone failed where the floor's deep Rayleigh dips
+   dominate the sums of squares); a suspected floor needs the scatter as well. Gauss-Newton now
+   starts from three floor levels (one record's fit had wandered to -170 dB). Tuning: floors
+   claimed without one 8/240 -> 1/240 (a beat), spans cut above a suspected floor on no-floor
+   records 44/240 -> 2/240, clean floors found 137 -> 138 of 140, the causes' no-floor records right
+   191 -> 194 of 200, verdicts on bases 41000000/42000000 (30 a class) unchanged, 356 of 360.
+   Regression tests: test/python/test_ringdown_regressions.py (clean 41000063, gamma_a 41200000
+   and det_loss 42500015 without a floor; 3 of its 6 tests fail on the previous tool).
+7. **The drive-off of a short plateau.** The plateau level is read from the record's first
+   twentieth and the decay starts where the envelope falls below that stretch's 5th percentile
+   (a beating plateau dips below its median). When the plateau is shorter than that stretch
+   (the generator's plateaus are 3 .. 15 % of the decay), the decay samples in it lowered the
+   percentile and put the drive-off up to 3 dB into the decay: on two-stage records the span then
+   started after most of a fast first stage and a single exponential (or gamma_nl) was called.
+   Reading two-stage misses on further tuning seeds (41/42 000030 .. 099, 140 records) found 4 of
+   6 so. The percentile is now also taken over the stretch up to its last sample at or above the
+   median, and that earlier crossing is used when the envelope does not come back above its level
+   before the first crossing (a plateau that beats less than once in the stretch does: beat
+   41300004 lost its plateau under the first version of this rule). Those 140 two-stage records
+   (the 4 misses read before the change, so in-sample): 134 -> 138; 100 further beats
+   (41/42 000030 .. 079): 97 -> 97; bases 41000000/42000000: 356 -> 356 of 360, no verdict
+   changed. Known-answer test: RingdownFit.ShortPlateauKeepsTheDriveOff (3 % plateau: the
+   drive-off within 0.3 s, 1.1 s late before); regression tests two_stage 41400082 and beat
+   41300004.
 
 ## Detector filter and the amplitude laws (the previous run's change, base 93517331)
 
@@ -528,7 +564,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--markdown")
     ap.add_argument("--n", type=int, default=100, help="records per class")
-    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=97308523,
+    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=98106237,
                     help="first seed (the reporting run uses the default; tune on others)")
     ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated subset")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("VALIDATE_JOBS", "2")))
@@ -549,6 +585,9 @@ def main():
             seed = a.seed + 100000 * ci + i
             with_floor = not (kind == "clean" and i % 10 < 3)
             jobs.append((kind, seed, with_floor, tmp))
+        if kind != "clean":  # the causes without a floor too (a fifth as many; other seeds)
+            for i in range(a.n // 5):
+                jobs.append((kind, a.seed + 100000 * ci + 50000 + i, False, tmp))
     t0 = time.time()
     if a.from_dump:
         with open(a.from_dump) as fh:
@@ -583,12 +622,15 @@ def main():
     fa = sum(bool(r["json"]["selected"]) or r["json"]["unexplained"] for r in ok_clean)
     rate_row("false alarms on clean records (extension or unexplained)", fa, len(ok_clean), None,
              FALSE_ALARM_MAX)
+    # Detection rows: the records with a floor (as in earlier runs); the causes' records without
+    # one have their own row below.
+    withfl = {k: [r for r in by[k] if r["floor"]] for k in CLASSES}
     for kind in ["gamma_nl", "gamma_a", "beat", "two_stage"]:
-        ok = [r for r in by[kind] if r["rc"] == 0]
-        k = sum(r["json"]["selected"] == [kind] for r in by[kind] if r["rc"] == 0)
-        rate_row("%s detected (selected = [%s])" % (kind, kind), k, len(by[kind]), DETECTION_MIN)
-    k = sum(r["rc"] == 0 and r["json"]["unexplained"] for r in by["det_loss"])
-    rate_row("detection loss flagged unexplained", k, len(by["det_loss"]), DETECTION_MIN)
+        k = sum(r["json"]["selected"] == [kind] for r in withfl[kind] if r["rc"] == 0)
+        rate_row("%s detected (selected = [%s])" % (kind, kind), k, len(withfl[kind]),
+                 DETECTION_MIN)
+    k = sum(r["rc"] == 0 and r["json"]["unexplained"] for r in withfl["det_loss"])
+    rate_row("detection loss flagged unexplained", k, len(withfl["det_loss"]), DETECTION_MIN)
     # The issue's criterion over every record: the right cause (a clean record: no extension and
     # not unexplained; a cause: selected = [it]; a detection loss: unexplained).
     def right(r):
@@ -602,12 +644,16 @@ def main():
         return j["selected"] == [r["kind"]]
     rate_row("correct cause, all classes", sum(right(r) for r in results), len(results),
              DETECTION_MIN)
+    causes_nf = [r for r in results if r["kind"] != "clean" and not r["floor"]]
+    if causes_nf:
+        rate_row("correct cause, the causes' records without a floor", sum(map(right, causes_nf)),
+                 len(causes_nf), DETECTION_MIN)
     withf = [r for r in results if r["floor"] and r["rc"] == 0 and r["kind"] == "clean"]
     nof = [r for r in results if not r["floor"] and r["rc"] == 0]
     rate_row("noise floor found (clean, with floor)",
              sum("noise_floor" in r["json"]["causes"] for r in withf), len(withf), DETECTION_MIN)
-    rate_row("noise floor claimed without one", sum("noise_floor" in r["json"]["causes"] for r in nof),
-             len(nof), None, FALSE_ALARM_MAX)
+    rate_row("noise floor claimed without one (all classes)",
+             sum("noise_floor" in r["json"]["causes"] for r in nof), len(nof), None, FALSE_ALARM_MAX)
     # Secondary figures (not pass/fail): coverage of Q0 and of the split, interval/CRB ratios.
     extra = []
     for kind, key, tkey in [("gamma_nl", "Q0", "Q"), ("gamma_a", "Q0", "Q"), ("beat", "frequency_split_hz", "split_hz"),
