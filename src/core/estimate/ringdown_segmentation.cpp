@@ -209,7 +209,7 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
   const int half = std::max(2, static_cast<int>(n / 100));
   const std::vector<double> sm = runningMedian(y, seg.dropout, half);
 
-  // 3 (first pass). Hinge fit of the smoothed envelope on a subsampled grid (<= 1500 points).
+  // A subsampled grid of the smoothed envelope (<= 1500 points) for the peak below.
   const size_t stride = std::max<size_t>(1, n / 1500);
   std::vector<size_t> idx;
   for (size_t i = 0; i < n; i += stride)
