@@ -85,8 +85,12 @@ class DemodRecovers(unittest.TestCase):
         self.wait_until(lambda: len(self.slow) > 0 and
                         (self.slow[-1].header.stamp - self.epoch).to_sec() > t_end - 0.03,
                         timeout, "slow states up to the end of the data")
-        self.wait_until(lambda: self.diag is not None and int(self.diag["out_of_range"]) >= 1,
-                        timeout, "diagnostics counting the out-of-range sample")
+        # Diagnostics are published about once a second: the one read must come after the last
+        # batch (an earlier one may predate the replayed batch and count no reset yet).
+        n_batches = len(batches)
+        self.wait_until(lambda: self.diag is not None and
+                        int(self.diag["batches"]) >= n_batches,
+                        timeout, "diagnostics after the last batch")
         with self.lock:
             slow = list(self.slow)
             diag = dict(self.diag)
