@@ -156,6 +156,7 @@ def main():
     ap.add_argument("--ids", default="")
     ap.add_argument("--timeout", type=float, default=300.0)
     ap.add_argument("--no-sheet", action="store_true")
+    ap.add_argument("--report-only", action="store_true", help="re-report OUT/PART/results.json")
     a = ap.parse_args()
     if not os.path.isdir(rc.data_dir()):
         print("validate_real_ringdown: %s absent, skipped" % rc.data_dir())
@@ -165,8 +166,12 @@ def main():
         i for i in labels if a.part == "all" or split.get(i) == a.part)
     out = os.path.join(a.out, a.part)
     os.makedirs(out, exist_ok=True)
-    with cf.ThreadPoolExecutor(a.jobs) as ex:
-        results = list(ex.map(lambda i: run_one(i, out, a.timeout), ids))
+    if a.report_only:
+        with open(os.path.join(out, "results.json")) as f:
+            results = json.load(f)
+    else:
+        with cf.ThreadPoolExecutor(a.jobs) as ex:
+            results = list(ex.map(lambda i: run_one(i, out, a.timeout), ids))
     for r in results:
         r["class"] = classes.get(r["id"], {}).get("class", "?")
         r["part"] = split.get(r["id"], "?")
@@ -226,7 +231,7 @@ def main():
             for m, c in refusals.most_common(8):
                 P("- %d x %s" % (c, m))
         dis = [r for r in rs if not r["within"]]
-        P("\nDisagreements (> 5 % or no Q): %s" % ", ".join(
+        P("\nDisagreements (> 5 %% or no Q): %s" % ", ".join(
             "%s[%s]" % (r["id"], r["class"]) for r in dis))
         if not a.no_sheet and dis:
             sheet_dir = os.path.join(out, "sheets")

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cvg_bench/core/estimate/ringdown_models.h"
+#include "cvg_bench/core/estimate/ringdown_record_window.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
@@ -171,8 +172,11 @@ std::vector<double> runningMedian(const std::vector<double>& y, const std::vecto
   return out;
 }
 
-RingdownSegment segmentRingdown(const RingdownEnvelope& env,
-                                const RingdownSegmentationOptions& options) {
+namespace {
+
+/// Steps 1-4 of the header on a window that holds one ring-down.
+RingdownSegment segmentWindow(const RingdownEnvelope& env,
+                              const RingdownSegmentationOptions& options) {
   const auto problems = options.validate();
   if (!problems.empty()) throw InputError("ring-down segmentation: " + problems.front());
   const size_t n = env.size();
@@ -424,6 +428,34 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
   if (seg.n_used < 8 ||
       !(seg.decay_db >= std::max(options.min_decay_db, 10.0 * seg.noise_sd_log * kDbPerNeper)))
     throw AnalysisError("ring-down: no decay to fit (" + seg.why + ")");
+  return seg;
+}
+
+}  // namespace
+
+RingdownSegment segmentRingdown(const RingdownEnvelope& env,
+                                const RingdownSegmentationOptions& options) {
+  const RingdownWindow w = findRingdownWindow(env.t_s, env.log_amplitude);
+  if (w.first == 0 && w.last == env.size()) return segmentWindow(env, options);
+  RingdownEnvelope sub;
+  sub.frequency_hz = env.frequency_hz;
+  sub.from_db = env.from_db;
+  sub.t_s.assign(env.t_s.begin() + w.first, env.t_s.begin() + w.last);
+  sub.log_amplitude.assign(env.log_amplitude.begin() + w.first,
+                           env.log_amplitude.begin() + w.last);
+  RingdownSegment seg;
+  try {
+    seg = segmentWindow(sub, options);
+  } catch (const AnalysisError& e) {
+    throw AnalysisError(std::string(e.what()) + " [" + w.why + "]");
+  }
+  // Back to the record's sample numbers; samples outside the window take no part in any fit.
+  std::vector<bool> dropout(env.size(), true);
+  std::copy(seg.dropout.begin(), seg.dropout.end(), dropout.begin() + w.first);
+  seg.dropout = std::move(dropout);
+  seg.i_start += w.first;
+  seg.i_end += w.first;
+  seg.why = w.why + "; " + seg.why;
   return seg;
 }
 

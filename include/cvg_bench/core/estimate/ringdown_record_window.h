@@ -1,0 +1,53 @@
+// The part of a real ring-down export that holds the last ring-down (docs/validation_ringdown.md,
+// "Real records"). Instrument files hold more than plateau-decay-floor: the floor before the drive
+// comes on and a ramp-up, a drive that toggles, a step at switch-off (the drive's own leakage
+// leaving the analyser's band), and after the decay a mode that drifts out of the band (a drop of
+// tens of dB in a few samples), a detector that switches range or stops (a step into a flat or
+// smooth line), a second burst. The segmentation (ringdown_segmentation.h) reads a plateau at the
+// head and a decay then a floor after it; this window gives it that shape:
+//  1. Steps: a sharp change of the smoothed level (medians of `step_half` samples either side
+//     differ by >= step_db and by 4 local difference sd, while each side's own change over the
+//     same number of samples is under a third of it).
+//  2. The drive level is the peak of the smoothed envelope. A step down that starts within
+//     near_top_db of it after the peak is a switch-off step: the window starts after it. A step up
+//     back to within near_top_db is the drive coming on again: the window restarts there.
+//  3. A record that starts more than start_below_db under the drive level (it begins at the floor
+//     or on the ramp-up) starts at its last rise through near_top_db / 2 below the peak.
+//  4. Any other step after the decay has begun (over near_top_db down) ends the window before it.
+//  5. A plateau longer than plateau_fraction of the rest is cut to that length before the last
+//     sample within off_below_db of the peak.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace cvg_bench {
+
+struct RingdownWindowOptions {
+  /// A step changes the smoothed level by at least this [dB] (real out-of-band drops are 20-75 dB,
+  /// switch-off steps 8-60 dB on the development set; the generator's smooth detection-gain
+  /// steps of 6-12 dB over 3-8 % of the span are not sharp and never qualify).
+  double step_db = 8.0;
+  /// Samples on each side whose median is compared (and over which each side must be flat).
+  int step_half = 3;
+  /// Within this of the peak level [dB]: still the drive level (switch-off, drive on again).
+  double near_top_db = 6.0;
+  /// A record whose first 2 % lie this far under the peak [dB] starts before the drive.
+  double start_below_db = 10.0;
+  /// The drive level is held while the smoothed envelope is within this of its peak [dB].
+  double off_below_db = 3.0;
+  /// A plateau longer than this fraction of the rest of the window is cut to it (the generator's
+  /// plateaus are 3-15 % of the decay and are never cut).
+  double plateau_fraction = 0.2;
+};
+
+struct RingdownWindow {
+  size_t first = 0, last = 0;  ///< samples [first, last) hold the ring-down
+  std::string why;             ///< empty when the whole record is kept
+};
+
+/// t: sample times, y: ln A (NaN where not finite).
+RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vector<double>& y,
+                                  const RingdownWindowOptions& options = {});
+
+}  // namespace cvg_bench

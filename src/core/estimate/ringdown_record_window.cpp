@@ -1,0 +1,133 @@
+#include "cvg_bench/core/estimate/ringdown_record_window.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "cvg_bench/core/estimate/ringdown_segmentation.h"
+
+namespace cvg_bench {
+namespace {
+
+constexpr double kDbPerNeper = 20.0 / 2.302585092994046;  // 20 / ln 10
+
+/// Median of the finite values of y[a, b) (clipped to the record); NaN when none.
+double medianOf(const std::vector<double>& y, long a, long b) {
+  std::vector<double> w;
+  for (long i = std::max(0L, a); i < std::min<long>(b, y.size()); ++i)
+    if (std::isfinite(y[i])) w.push_back(y[i]);
+  if (w.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const size_t m = w.size() / 2;
+  std::nth_element(w.begin(), w.begin() + m, w.end());
+  return w[m];
+}
+
+struct Step {
+  size_t i = 0;         ///< first sample after the step
+  double left = 0.0;    ///< level before [dB]
+  double right = 0.0;   ///< level after [dB]
+};
+
+/// Sharp steps of the level y_db (step 1 of the header), in time order.
+std::vector<Step> findSteps(const std::vector<double>& y_db, const RingdownWindowOptions& o) {
+  std::vector<Step> steps;
+  const long n = static_cast<long>(y_db.size()), h = std::max(1, o.step_half);
+  for (long i = 2 * h; i + 2 * h <= n; ++i) {
+    const double L = medianOf(y_db, i - h, i), R = medianOf(y_db, i, i + h);
+    const double jump = std::fabs(R - L);
+    if (!(jump >= o.step_db)) continue;
+    const double L2 = medianOf(y_db, i - 2 * h, i - h), R2 = medianOf(y_db, i + h, i + 2 * h);
+    if (!(std::fabs(L - L2) < jump / 3.0 && std::fabs(R2 - R) < jump / 3.0)) continue;
+    // Local scatter of the differences on both sides, the jump itself left out.
+    std::vector<double> d;
+    for (long k = i - 2 * h + 1; k < i + 2 * h; ++k)
+      if (k != i && std::isfinite(y_db[k]) && std::isfinite(y_db[k - 1]))
+        d.push_back(std::fabs(y_db[k] - y_db[k - 1]));
+    if (!d.empty()) {
+      std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+      if (jump < 4.0 * 1.4826 * d[d.size() / 2]) continue;
+    }
+    // Keep the largest jump of a cluster of adjacent candidates.
+    if (!steps.empty() && static_cast<long>(steps.back().i) + h >= i) {
+      if (jump > std::fabs(steps.back().right - steps.back().left)) steps.back() = {size_t(i), L, R};
+      continue;
+    }
+    steps.push_back({static_cast<size_t>(i), L, R});
+  }
+  return steps;
+}
+
+}  // namespace
+
+RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vector<double>& y,
+                                  const RingdownWindowOptions& o) {
+  const size_t n = y.size();
+  RingdownWindow w;
+  w.last = n;
+  if (n < 16 || t.size() != n) return w;
+  std::vector<double> y_db(n);
+  std::vector<bool> skip(n);
+  for (size_t i = 0; i < n; ++i) {
+    y_db[i] = std::isfinite(y[i]) ? y[i] * kDbPerNeper : std::numeric_limits<double>::quiet_NaN();
+    skip[i] = !std::isfinite(y[i]);
+  }
+  const std::vector<double> sm = runningMedian(y_db, skip, std::max<int>(2, n / 200));
+  size_t i_peak = 0;
+  double top = -std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < n; ++i)
+    if (std::isfinite(sm[i]) && sm[i] > top) top = sm[i], i_peak = i;
+  if (!std::isfinite(top)) return w;
+  std::ostringstream why;
+  why.precision(4);
+  // 3. A record that starts under the drive level.
+  const double head = medianOf(sm, 0, std::max<long>(5, n / 50));
+  if (top - head > o.start_below_db) {
+    size_t j = i_peak;
+    while (j > 0 && !(std::isfinite(sm[j - 1]) && sm[j - 1] < top - 0.5 * o.near_top_db)) --j;
+    w.first = j;
+    why << "the record starts " << top - head << " dB under the drive level (floor before the "
+        << "drive or its ramp-up): read from " << t[j] << " s";
+  }
+  // 2 and 4. Steps after the peak.
+  for (const Step& s : findSteps(y_db, o)) {
+    if (s.i <= i_peak || s.i <= w.first) continue;
+    const double jump = s.right - s.left;
+    if (s.left >= top - o.near_top_db && jump < 0.0) {
+      w.first = s.i;
+      why << (why.tellp() > 0 ? "; " : "") << "a step of " << jump << " dB at switch-off ("
+          << t[s.i] << " s): the decay is read after it";
+    } else if (s.right >= top - o.near_top_db && jump > 0.0) {
+      w.first = s.i;
+      why << (why.tellp() > 0 ? "; " : "") << "the drive comes on again at " << t[s.i]
+          << " s: the last ring-down is read";
+    } else {
+      w.last = s.i > static_cast<size_t>(o.step_half) ? s.i - o.step_half : s.i;
+      why << (why.tellp() > 0 ? "; " : "") << "a step of " << (jump > 0 ? "+" : "") << jump
+          << " dB in " << o.step_half << " samples at " << t[s.i]
+          << " s after the decay began (the mode leaves the detector's band, or the detector "
+             "changes range or stops): the record is read up to "
+          << t[w.last - 1] << " s";
+      break;
+    }
+  }
+  // 5. A long plateau (over plateau_fraction of what follows the switch-off) is cut to that
+  // fraction before it: the segmentation reads the drive level from the window's head, and a long
+  // plateau that wanders or creeps over the drive-off threshold hides the switch-off.
+  if (w.last > w.first) {
+    size_t i_off = w.first;
+    for (size_t i = w.first; i < w.last; ++i)
+      if (std::isfinite(sm[i]) && sm[i] >= top - o.off_below_db) i_off = i;
+    const size_t keep = static_cast<size_t>(o.plateau_fraction * double(w.last - i_off));
+    if (i_off > w.first + std::max<size_t>(keep, 8)) {
+      w.first = i_off - std::max<size_t>(keep, 8);
+      why << (why.tellp() > 0 ? "; " : "") << "the drive level is last held at " << t[i_off]
+          << " s: read from " << t[w.first] << " s";
+    }
+  }
+  if (w.last <= w.first) w.first = 0, w.last = n, why.str("");
+  w.why = why.str();
+  return w;
+}
+
+}  // namespace cvg_bench

@@ -1,0 +1,81 @@
+// Known-answer tests of the real-export window (ringdown_record_window.h) on envelopes shaped like
+// the development set's records: floor before the drive, switch-off steps, out-of-band drops.
+#include "cvg_bench/core/estimate/ringdown_record_window.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace cvg_bench {
+namespace {
+
+constexpr double kNeperPerDb = 2.302585092994046 / 20.0;
+
+/// A record in dB sampled at 1 s: level(t) piecewise, plus 0.3 dB white noise; returned as ln A.
+struct Rec {
+  std::vector<double> t, y;
+};
+template <class F>
+Rec make(int n, F level, unsigned seed = 1) {
+  std::mt19937 g(seed);
+  std::normal_distribution<double> e(0.0, 0.3);
+  Rec r;
+  for (int i = 0; i < n; ++i) {
+    r.t.push_back(i);
+    r.y.push_back((level(double(i)) + e(g)) * kNeperPerDb);
+  }
+  return r;
+}
+
+TEST(RingdownWindow, APlainRecordIsKeptWhole) {
+  const Rec r = make(600, [](double t) { return t < 100 ? 0.0 : std::max(-0.3 * (t - 100), -80.0); });
+  const RingdownWindow w = findRingdownWindow(r.t, r.y);
+  EXPECT_EQ(w.first, 0u);
+  EXPECT_EQ(w.last, 600u);
+  EXPECT_TRUE(w.why.empty());
+}
+
+TEST(RingdownWindow, ARecordStartingAtTheFloorStartsAtTheDriveLevel) {
+  // floor -80 dB until 100 s, ramp to 0 dB by 150 s, plateau to 200 s, decay 0.3 dB/s to -80.
+  const Rec r = make(800, [](double t) {
+    if (t < 100) return -80.0;
+    if (t < 150) return -80.0 + 80.0 * (t - 100) / 50;
+    if (t < 200) return 0.0;
+    return std::max(-0.3 * (t - 200), -80.0);
+  });
+  const RingdownWindow w = findRingdownWindow(r.t, r.y);
+  EXPECT_GE(w.first, 146u);  // last rise through -3 dB at 148 s
+  EXPECT_LE(w.first, 150u);
+  EXPECT_EQ(w.last, 800u);
+  EXPECT_NE(w.why.find("under the drive level"), std::string::npos);
+}
+
+TEST(RingdownWindow, ASwitchOffStepIsSkippedAndAnOutOfBandDropEndsTheWindow) {
+  // plateau 0 dB to 100 s, a 15 dB step at switch-off, decay 0.2 dB/s, at 250 s a 50 dB drop.
+  const Rec r = make(500, [](double t) {
+    if (t < 100) return 0.0;
+    if (t < 250) return -15.0 - 0.2 * (t - 100);
+    return -95.0;
+  });
+  const RingdownWindow w = findRingdownWindow(r.t, r.y);
+  EXPECT_EQ(w.first, 100u);
+  EXPECT_GE(w.last, 240u);
+  EXPECT_LE(w.last, 250u);
+  EXPECT_NE(w.why.find("switch-off"), std::string::npos);
+  EXPECT_NE(w.why.find("leaves the detector"), std::string::npos);
+}
+
+TEST(RingdownWindow, ASmoothGainStepOfTheGeneratorIsNoStep) {
+  // The generator's detection loss: 10 dB over ~20 samples, mid-decay.
+  const Rec r = make(600, [](double t) {
+    const double base = t < 50 ? 0.0 : -0.2 * (t - 50);
+    return base - 10.0 / (1.0 + std::exp(-(t - 300) / 5.0));
+  });
+  const RingdownWindow w = findRingdownWindow(r.t, r.y);
+  EXPECT_EQ(w.first, 0u);
+  EXPECT_EQ(w.last, 600u);
+}
+
+}  // namespace
+}  // namespace cvg_bench
