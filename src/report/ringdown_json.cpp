@@ -105,6 +105,8 @@ nlohmann::json ringdownExplanationToJson(const RingdownExplanation& x, double co
                      {"information_criterion", num(s.information_criterion)},
                      {"hold_out_error", num(s.hold_out_error)},
                      {"hold_out_reference", num(s.hold_out_reference)},
+                     {"effect_db", num(s.effect_db)},
+                     {"effect_over_rms", num(s.effect_over_rms)},
                      {"note", s.note}});
   j["steps"] = steps;
   j["selection"] = {{"criterion",

@@ -231,6 +231,12 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     s.significant = ic_lin - s.information_criterion > options.margin;
     s.note = signCheck(f);
     s.physical = s.note.empty();
+    if (f.fitted.size() == x.baseline.fitted.size()) {
+      for (size_t i = 0; i < f.fitted.size(); ++i)
+        s.effect_db = std::max(s.effect_db, std::fabs(f.fitted[i] - x.baseline.fitted[i]));
+      s.effect_db *= 20.0 / std::log(10.0);
+      s.effect_over_rms = s.effect_db / std::max(x.baseline.rms_log * 20.0 / std::log(10.0), 1e-300);
+    }
     x.information_criterion[s.added] = s.information_criterion;
     if (isAmplitudeLaw(s.added)) {
       if (s.physical)

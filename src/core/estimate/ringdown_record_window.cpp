@@ -27,6 +27,7 @@ struct Step {
   size_t i = 0;         ///< first sample after the step
   double left = 0.0;    ///< level before [dB]
   double right = 0.0;   ///< level after [dB]
+  double sharp = 0.0;   ///< jump over the local sd of sample-to-sample differences
 };
 
 /// Sharp steps of the level y_db (step 1 of the header), in time order.
@@ -39,21 +40,25 @@ std::vector<Step> findSteps(const std::vector<double>& y_db, const RingdownWindo
     if (!(jump >= o.step_db)) continue;
     const double L2 = medianOf(y_db, i - 2 * h, i - h), R2 = medianOf(y_db, i + h, i + 2 * h);
     if (!(std::fabs(L - L2) < jump / 3.0 && std::fabs(R2 - R) < jump / 3.0)) continue;
-    // Local scatter of the differences on both sides, the jump itself left out.
+    // Local scatter of the differences over 10 samples each side, the jump itself left out.
     std::vector<double> d;
-    for (long k = i - 2 * h + 1; k < i + 2 * h; ++k)
+    for (long k = std::max(1L, i - 10); k < std::min(n, i + 11); ++k)
       if (k != i && std::isfinite(y_db[k]) && std::isfinite(y_db[k - 1]))
         d.push_back(std::fabs(y_db[k] - y_db[k - 1]));
+    double sd = 0.0;
     if (!d.empty()) {
       std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-      if (jump < 4.0 * 1.4826 * d[d.size() / 2]) continue;
+      sd = 1.4826 * d[d.size() / 2];
     }
+    const double sharp = jump / std::max(sd, 1e-12);
+    if (sharp < 4.0) continue;
     // Keep the largest jump of a cluster of adjacent candidates.
     if (!steps.empty() && static_cast<long>(steps.back().i) + h >= i) {
-      if (jump > std::fabs(steps.back().right - steps.back().left)) steps.back() = {size_t(i), L, R};
+      if (jump > std::fabs(steps.back().right - steps.back().left))
+        steps.back() = {size_t(i), L, R, sharp};
       continue;
     }
-    steps.push_back({static_cast<size_t>(i), L, R});
+    steps.push_back({static_cast<size_t>(i), L, R, sharp});
   }
   return steps;
 }
@@ -101,7 +106,7 @@ RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vecto
       w.first = s.i;
       why << (why.tellp() > 0 ? "; " : "") << "the drive comes on again at " << t[s.i]
           << " s: the last ring-down is read";
-    } else {
+    } else if (std::fabs(jump) >= o.end_step_db || s.sharp >= o.end_step_sharpness) {
       w.last = s.i > static_cast<size_t>(o.step_half) ? s.i - o.step_half : s.i;
       why << (why.tellp() > 0 ? "; " : "") << "a step of " << (jump > 0 ? "+" : "") << jump
           << " dB in " << o.step_half << " samples at " << t[s.i]
@@ -109,6 +114,29 @@ RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vecto
              "changes range or stops): the record is read up to "
           << t[w.last - 1] << " s";
       break;
+    }
+  }
+  // 6. A noiseless tail: from some sample to the window's end the local roughness (median
+  // |second difference| over 11 samples) stays under tail_roughness_db, 10 dB or more below the
+  // peak, over a tenth of the window at least, while the tenth before it is 30 times rougher. No
+  // instrument records that after a measured decay; exports append it (a fitted or padded curve).
+  {
+    std::vector<double> e2(n, std::numeric_limits<double>::quiet_NaN()), rough(n, 0.0);
+    for (size_t i = 1; i + 1 < n; ++i) e2[i] = std::fabs(y_db[i + 1] - 2.0 * y_db[i] + y_db[i - 1]);
+    for (size_t i = 0; i < n; ++i) rough[i] = medianOf(e2, long(i) - 5, long(i) + 6);
+    size_t k = w.last;
+    while (k > std::max(w.first, i_peak) + 1 &&
+           (!std::isfinite(rough[k - 1]) || rough[k - 1] <= o.tail_roughness_db))
+      --k;
+    const size_t tenth = std::max<size_t>(10, (w.last - w.first) / 10);
+    const double inside = medianOf(rough, k, w.last);
+    const double before = medianOf(rough, long(k) - long(tenth), k);
+    if (w.last - k >= tenth && k > tenth && std::isfinite(sm[k]) && sm[k] < top - 10.0 &&
+        before >= 30.0 * inside) {
+      why << (why.tellp() > 0 ? "; " : "") << "from " << t[k] << " s the level is noiseless "
+          << "(roughness " << inside << " dB against " << before << " dB before it: a curve the "
+          << "export appended, not a measurement): the record is read up to there";
+      w.last = k;
     }
   }
   // 5. A long plateau (over plateau_fraction of what follows the switch-off) is cut to that
@@ -125,7 +153,8 @@ RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vecto
           << " s: read from " << t[w.first] << " s";
     }
   }
-  if (w.last <= w.first) w.first = 0, w.last = n, why.str("");
+  // A window too short to hold a ring-down (a twentieth of the record, 16 samples) is no window.
+  if (w.last < w.first + std::max<size_t>(16, n / 20)) w.first = 0, w.last = n, why.str("");
   w.why = why.str();
   return w;
 }

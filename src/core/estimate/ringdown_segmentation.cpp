@@ -5,9 +5,12 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <cstdio>
+#include <cstdlib>
 
 #include "cvg_bench/core/estimate/ringdown_models.h"
 #include "cvg_bench/core/estimate/ringdown_record_window.h"
+#include "cvg_bench/core/estimate/ringdown_straight_span.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
@@ -433,10 +436,91 @@ RingdownSegment segmentWindow(const RingdownEnvelope& env,
 
 }  // namespace
 
+namespace {
+
+/// Level [dB] near sample i: median of the finite, non-skipped samples within 2 of it.
+double levelNear(const RingdownEnvelope& env, const std::vector<bool>& skip, size_t i) {
+  std::vector<double> w;
+  for (size_t k = i >= 2 ? i - 2 : 0; k < std::min(env.size(), i + 3); ++k)
+    if (!skip[k] && std::isfinite(env.log_amplitude[k])) w.push_back(env.log_amplitude[k]);
+  return median(w) * kDbPerNeper;
+}
+
+/// The span's counts, times and decay after its ends moved.
+void setSpan(const RingdownEnvelope& env, size_t i_start, size_t i_end, RingdownSegment* seg) {
+  seg->i_start = i_start, seg->i_end = i_end;
+  seg->n_used = seg->n_dropouts_in_span = 0;
+  for (size_t i = i_start; i < i_end; ++i) seg->dropout[i] ? ++seg->n_dropouts_in_span : ++seg->n_used;
+  seg->t_start_s = env.t_s[i_start];
+  seg->t_end_s = env.t_s[i_end - 1];
+  seg->decay_db = levelNear(env, seg->dropout, i_start) - levelNear(env, seg->dropout, i_end - 1);
+}
+
+/// The straight stretch (ringdown_straight_span.h) corrects the span where the plateau-and-floor
+/// reading of steps 2-3 does not hold on a real export: a start on a plateau that creeps or
+/// wanders (the level falls at under half the decay rate up to the stretch), and an end past a
+/// floor that wanders (the stretch ends in a floor's scatter before the span does). Smooth bends
+/// (a damping law, two stages) and faster falls (a detection loss) are left to the models.
+void correctWithStraightSpan(const RingdownEnvelope& env, RingdownSegment* seg,
+                             std::ostringstream* why) {
+  const StraightSpan ss = findStraightSpan(env.t_s, env.log_amplitude, seg->dropout);
+  if (std::getenv("CVG_DEBUG_SPAN"))
+    fprintf(stderr, "ss ok %d [%g, %g] slope %g span %g end %d post %g; seg [%g, %g]\n", ss.ok,
+            env.t_s[ss.i_start], env.t_s[std::max<size_t>(ss.i_end, 1) - 1], ss.slope_db_s,
+            ss.span_db, int(ss.end), ss.post_slope_db_s, seg->t_start_s, seg->t_end_s);
+  if (!ss.ok || ss.span_db < 10.0) return;
+  why->precision(4);
+  size_t a = seg->i_start, b = seg->i_end;
+  if (ss.i_start > a && ss.i_start + 8 < b) {
+    const double fall = levelNear(env, seg->dropout, a) - levelNear(env, seg->dropout, ss.i_start);
+    const double expected = -ss.slope_db_s * (env.t_s[ss.i_start] - env.t_s[a]);
+    // The lowest level before the stretch against its line extrapolated back: a detector's
+    // switch-off transient undershoots and comes back; a decay (fast first stage, damping law)
+    // stays above the line of its slower part.
+    double under = 0.0;
+    const double c0 = levelNear(env, seg->dropout, ss.i_start);
+    for (size_t i = a; i < ss.i_start; ++i)
+      under = std::max(under, c0 + ss.slope_db_s * (env.t_s[i] - env.t_s[ss.i_start]) -
+                                  levelNear(env, seg->dropout, i));
+    if (under > 3.0 && ss.i_start - a <= (b - a) * 15 / 100) {
+      *why << "; the level dips " << under << " dB below the decay's line before "
+           << env.t_s[ss.i_start] << " s and comes back (a detector's switch-off transient): "
+           << "the span starts at " << env.t_s[ss.i_start] << " s";
+      a = ss.i_start;
+    } else if (fall < 0.5 * expected) {
+      *why << "; the level falls " << fall << " dB from " << env.t_s[a] << " s to "
+           << env.t_s[ss.i_start] << " s where the decay rate gives " << expected
+           << " dB (drive still on or settling): the span starts at " << env.t_s[ss.i_start]
+           << " s";
+      a = ss.i_start;
+    }
+  }
+  // Past the stretch, up to the span's end: a floor (or a detector's tail) stops falling; a
+  // slowing decay or a beat still falls at over flat_fraction of the rate on the whole.
+  if (ss.i_end + 8 < b && ss.i_end > a + 8) {
+    std::vector<double> tt, yy;
+    for (size_t i = ss.i_end; i < b; ++i)
+      if (!seg->dropout[i] && std::isfinite(env.log_amplitude[i]))
+        tt.push_back(env.t_s[i]), yy.push_back(env.log_amplitude[i] * kDbPerNeper);
+    if (tt.size() >= 8) {
+      std::vector<bool> keep(tt.size(), false);
+      const double post = slopeOver(tt, yy, keep, 0, tt.size());
+      if (post > StraightSpanOptions().flat_fraction * ss.slope_db_s) {
+        *why << "; the straight decay meets a floor at " << env.t_s[ss.i_end - 1]
+             << " s (from there to " << env.t_s[b - 1] << " s the level falls at " << post
+             << " dB/s against " << ss.slope_db_s << " dB/s): the span ends there";
+        b = ss.i_end;
+      }
+    }
+  }
+  if (a != seg->i_start || b != seg->i_end) setSpan(env, a, b, seg);
+}
+
+}  // namespace
+
 RingdownSegment segmentRingdown(const RingdownEnvelope& env,
                                 const RingdownSegmentationOptions& options) {
   const RingdownWindow w = findRingdownWindow(env.t_s, env.log_amplitude);
-  if (w.first == 0 && w.last == env.size()) return segmentWindow(env, options);
   RingdownEnvelope sub;
   sub.frequency_hz = env.frequency_hz;
   sub.from_db = env.from_db;
@@ -444,18 +528,41 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
   sub.log_amplitude.assign(env.log_amplitude.begin() + w.first,
                            env.log_amplitude.begin() + w.last);
   RingdownSegment seg;
+  std::string refusal;
   try {
     seg = segmentWindow(sub, options);
   } catch (const AnalysisError& e) {
-    throw AnalysisError(std::string(e.what()) + " [" + w.why + "]");
+    refusal = e.what();
   }
-  // Back to the record's sample numbers; samples outside the window take no part in any fit.
+  std::ostringstream why;
+  why << w.why;
   std::vector<bool> dropout(env.size(), true);
-  std::copy(seg.dropout.begin(), seg.dropout.end(), dropout.begin() + w.first);
-  seg.dropout = std::move(dropout);
-  seg.i_start += w.first;
-  seg.i_end += w.first;
-  seg.why = w.why + "; " + seg.why;
+  if (refusal.empty()) {
+    // Back to the record's sample numbers; samples outside the window take no part in any fit.
+    std::copy(seg.dropout.begin(), seg.dropout.end(), dropout.begin() + w.first);
+    seg.dropout = std::move(dropout);
+    seg.i_start += w.first;
+    seg.i_end += w.first;
+    why << (w.why.empty() ? "" : "; ") << seg.why;
+    correctWithStraightSpan(env, &seg, &why);
+  } else {
+    // The plateau-and-floor reading found no decay: a straight stretch of 10 dB or more is one.
+    for (size_t i = w.first; i < w.last; ++i) dropout[i] = !std::isfinite(env.log_amplitude[i]);
+    const StraightSpan ss = findStraightSpan(env.t_s, env.log_amplitude, dropout);
+    if (std::getenv("CVG_DEBUG_SPAN"))
+      fprintf(stderr, "fallback ss ok %d [%zu, %zu] slope %g span %g\n", ss.ok, ss.i_start,
+              ss.i_end, ss.slope_db_s, ss.span_db);
+    if (!ss.ok || ss.span_db < 10.0)
+      throw AnalysisError(refusal + (w.why.empty() ? "" : " [" + w.why + "]"));
+    seg.dropout = std::move(dropout);
+    seg.drive_off_s = env.t_s[ss.i_start];
+    setSpan(env, ss.i_start, ss.i_end, &seg);
+    why.precision(4);
+    why << (w.why.empty() ? "" : "; ") << "no plateau or floor read (" << refusal
+        << "); a straight decay of " << ss.span_db << " dB from " << seg.t_start_s << " s to "
+        << seg.t_end_s << " s, ending in " << ss.endName();
+  }
+  seg.why = why.str();
   return seg;
 }
 

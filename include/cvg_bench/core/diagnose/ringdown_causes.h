@@ -59,6 +59,9 @@ struct RingdownStep {
   double information_criterion = 0.0;  ///< BIC on the effective sample size
   double hold_out_error = 0.0;         ///< blocked two-fold prediction error (the pick only)
   double hold_out_reference = 0.0;     ///< the same for the rival it had to beat
+  /// Largest difference between the extension's and the single exponential's fitted level over
+  /// the span [dB], and its ratio to the single exponential's rms residual: the effect's size.
+  double effect_db = 0.0, effect_over_rms = 0.0;
 };
 
 struct RingdownExplanation {

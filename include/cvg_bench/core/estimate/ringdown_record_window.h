@@ -13,7 +13,10 @@
 //     back to within near_top_db is the drive coming on again: the window restarts there.
 //  3. A record that starts more than start_below_db under the drive level (it begins at the floor
 //     or on the ramp-up) starts at its last rise through near_top_db / 2 below the peak.
-//  4. Any other step after the decay has begun (over near_top_db down) ends the window before it.
+//  4. Any other step after the decay has begun (over near_top_db down) ends the window before it
+//     when it is large (end_step_db) or sharp (end_step_sharpness local sd).
+//  6. (Before 5.) A tail that is noiseless to the record's end (roughness under tail_roughness_db
+//     and 30 times under the stretch before it) is an appended curve: the window ends there.
 //  5. A plateau longer than plateau_fraction of the rest is cut to that length before the last
 //     sample within off_below_db of the peak.
 #pragma once
@@ -28,6 +31,11 @@ struct RingdownWindowOptions {
   /// switch-off steps 8-60 dB on the development set; the generator's smooth detection-gain
   /// steps of 6-12 dB over 3-8 % of the span are not sharp and never qualify).
   double step_db = 8.0;
+  /// A step that ends the window (after the decay began) is at least this large [dB], or at
+  /// least end_step_sharpness local difference sd: a noise floor's own jumps (8-10 dB at 4-10 sd
+  /// in the generator's lock-in floors) must not end it.
+  double end_step_db = 20.0;
+  double end_step_sharpness = 12.0;
   /// Samples on each side whose median is compared (and over which each side must be flat).
   int step_half = 3;
   /// Within this of the peak level [dB]: still the drive level (switch-off, drive on again).
@@ -39,6 +47,10 @@ struct RingdownWindowOptions {
   /// A plateau longer than this fraction of the rest of the window is cut to it (the generator's
   /// plateaus are 3-15 % of the decay and are never cut).
   double plateau_fraction = 0.2;
+  /// A tail whose roughness (median |second difference|) stays under this [dB] to the end, 30
+  /// times smoother than what precedes it, is no measurement (the 750-point exports of the
+  /// development set end in such curves at 1e-4..1e-3 dB; their decays and floors are 0.2-3 dB).
+  double tail_roughness_db = 0.003;
 };
 
 struct RingdownWindow {
