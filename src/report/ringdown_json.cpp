@@ -16,6 +16,14 @@ nlohmann::json valueJson(const RingdownValue& v) {
                       {"ci_low", num(v.ci_low)},
                       {"ci_high", num(v.ci_high)}};
   if (v.crb_std > 0.0) j["crb_std"] = num(v.crb_std);
+  if (std::isfinite(v.std_span)) {
+    // The within-record interval above; the span choice's part and the total beside it.
+    j["std_within"] = num(v.std);
+    j["std_span"] = num(v.std_span);
+    j["std_total"] = num(v.std_total);
+    j["ci_total_low"] = num(v.ci_total_low);
+    j["ci_total_high"] = num(v.ci_total_high);  // null: open above
+  }
   return j;
 }
 

@@ -15,6 +15,7 @@
 #include "bag_input.h"
 #include "cli_args.h"
 #include "cvg_bench/core/diagnose/ringdown_causes.h"
+#include "cvg_bench/core/estimate/ringdown_span_spread.h"
 #include "cvg_bench/core/io/ringdown_record.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/ringdown_simulator.h"
@@ -215,7 +216,8 @@ int runRingdownIdentify(const std::vector<std::string>& argv) {
   so.floor_margin_db = args.getDouble("floor-margin-db", so.floor_margin_db);
   const RingdownFitOptions fo = fitOptions(args);
   const RingdownSegment seg = segmentRingdown(env, so);
-  const RingdownFit fit = fitRingdown(env, seg, model, fo);
+  RingdownFit fit = fitRingdown(env, seg, model, fo);
+  addSpanSpread(env, seg, fo, &fit);
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::cout << std::setprecision(6);
   printFit(fit, seg, std::cout);

@@ -187,6 +187,19 @@ RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen
   }
   double c = 1.0;
   for (int l = 1; l <= L; ++l) c += 2.0 * rho[l];
+  bool ar1_fallback = false;
+  if (!std::isfinite(c)) {
+    // The AR fit degenerated (a residual series with exact repeats): the lag-1 AR model of the
+    // sample correlation instead, so the interval is neither of zero width nor NaN.
+    const double r1 = std::max(-0.99, std::min(0.99, std::isfinite(out.rho1) ? out.rho1 : 0.0));
+    out.ar.assign(1, r1);
+    rho.assign(max_lag + 1, 0.0);
+    rho[0] = 1.0;
+    L = 0;
+    for (int l = 1; l <= max_lag && std::fabs(std::pow(r1, l)) >= 1e-4; ++l) rho[l] = std::pow(r1, l), L = l;
+    c = (1.0 + r1) / (1.0 - r1);
+    ar1_fallback = true;
+  }
   out.long_run_factor = std::max(c, 1.0 / n);
   out.effective_n = n / std::max(out.long_run_factor, 1e-3);
   out.student_df = std::floor(out.effective_n) - p;
@@ -199,6 +212,7 @@ RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen
   }
   out.covariance = var_r * jtj_inv * meat * jtj_inv;
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
+  if (ar1_fallback) m << "AR(" << best_p << ") fit degenerate, lag-1 correlation used; ";
   m << "AR(" << best_p << ") noise model of the weighted ln A residuals (order by BIC; lag-1 "
     << out.rho1 << ", Ljung-Box p " << out.ljung_box_p << ", long-run variance factor "
     << out.long_run_factor << ", " << L << " lags): sandwich (J'J)^-1 J' Sigma_AR J (J'J)^-1";

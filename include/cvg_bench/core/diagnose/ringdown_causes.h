@@ -40,6 +40,9 @@ struct RingdownExplainOptions {
   double margin = 20.0;
   /// A beat or two-stage decay must lie this far below every physical amplitude law.
   double law_margin = 10.0;
+  /// An accepted beat or two-stage decay has its Q within this factor of the single
+  /// exponential's over the same span (else it is not the decay read off the record).
+  double q_factor = 1.5;
   /// Candidate extensions tried (ringdownExtensionNames() by default).
   std::vector<std::string> candidates = {"gamma_nl", "gamma_a", "beat", "two_stage"};
   RingdownFitOptions fit;

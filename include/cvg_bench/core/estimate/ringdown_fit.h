@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 #include <map>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,11 @@ struct RingdownFitOptions {
 /// A value with its standard error, interval, and the Cramer-Rao standard error (0 when none).
 struct RingdownValue {
   double value = 0.0, std = 0.0, ci_low = 0.0, ci_high = 0.0, crb_std = 0.0;
+  /// Q and Q0 only (ringdown_span_spread.h): the span choice's part and the total; NaN unset.
+  double std_span = std::numeric_limits<double>::quiet_NaN();
+  double std_total = std::numeric_limits<double>::quiet_NaN();
+  double ci_total_low = std::numeric_limits<double>::quiet_NaN();
+  double ci_total_high = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Local Q over one amplitude bin (a straight ln A fit there, HAC interval).

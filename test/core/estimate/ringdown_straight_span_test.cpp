@@ -1,0 +1,76 @@
+// Known-answer tests of the longest straight stretch (ringdown_straight_span.h).
+#include "cvg_bench/core/estimate/ringdown_straight_span.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace cvg_bench {
+namespace {
+
+constexpr double kNeperPerDb = 2.302585092994046 / 20.0;
+
+struct Rec {
+  std::vector<double> t, y;
+  std::vector<bool> skip;
+};
+
+/// level(t) in dB at 1 sample/s plus white noise of sd_db; a Rayleigh-like floor where asked.
+template <class F>
+Rec make(int n, F level, double sd_db, unsigned seed = 2) {
+  std::mt19937 g(seed);
+  std::normal_distribution<double> e(0.0, sd_db);
+  Rec r;
+  for (int i = 0; i < n; ++i) {
+    r.t.push_back(i);
+    r.y.push_back((level(double(i)) + e(g)) * kNeperPerDb);
+    r.skip.push_back(false);
+  }
+  return r;
+}
+
+TEST(RingdownStraightSpan, ADecayIntoAWanderingFloorEndsAtTheFloorWithItsSlope) {
+  // Plateau to 50 s, decay 0.25 dB/s to a floor at -60 dB that wanders +-8 dB slowly.
+  const Rec r = make(
+      800,
+      [](double t) {
+        const double decay = t < 50 ? 0.0 : -0.25 * (t - 50);
+        const double floor = -60.0 + 8.0 * std::sin(t / 23.0);
+        return 10.0 * std::log10(std::pow(10.0, decay / 10.0) + std::pow(10.0, floor / 10.0));
+      },
+      0.3);
+  const StraightSpan s = findStraightSpan(r.t, r.y, r.skip);
+  ASSERT_TRUE(s.ok);
+  EXPECT_NEAR(s.slope_db_s, -0.25, 0.01);
+  EXPECT_GE(s.i_start, 50u);
+  EXPECT_LE(s.i_start, 60u);
+  // The line meets the floor's crests (-52 dB) at 258 s: the stretch ends before them.
+  EXPECT_GT(s.i_end, 180u);
+  EXPECT_LT(s.i_end, 270u);
+  EXPECT_EQ(s.end, StraightSpanEnd::kFloor);
+}
+
+TEST(RingdownStraightSpan, AShortSwitchOffTransientDoesNotWin) {
+  // A 20 dB fall in 5 samples at switch-off, then a 0.1 dB/s decay over 400 s.
+  const Rec r = make(
+      500,
+      [](double t) {
+        if (t < 50) return 0.0;
+        if (t < 55) return -4.0 * (t - 50);
+        return -20.0 - 0.1 * (t - 55);
+      },
+      0.1);
+  const StraightSpan s = findStraightSpan(r.t, r.y, r.skip);
+  ASSERT_TRUE(s.ok);
+  EXPECT_NEAR(s.slope_db_s, -0.1, 0.005);
+  EXPECT_GE(s.i_start, 55u);
+}
+
+TEST(RingdownStraightSpan, NoDecayIsNoStretch) {
+  const Rec r = make(300, [](double) { return -40.0; }, 1.0);
+  EXPECT_FALSE(findStraightSpan(r.t, r.y, r.skip).ok);
+}
+
+}  // namespace
+}  // namespace cvg_bench
