@@ -52,9 +52,16 @@ clean:
 	rm -rf build
 
 # Independent validation (docs/validation_independent.md; under 30 min on 2 cores).
-.PHONY: validate
+.PHONY: validate validate-real
 validate: build
 	@bash scripts/validate_all.sh
+
+# Real ring-down exports (../shared/data/ringdowns_qpit_dev, skipped when absent): both parts of
+# the committed split against the authors' Q, contact sheets in build/validate_real
+# (docs/validation_ringdown_real.md).
+validate-real: build
+	@/usr/bin/python3 scripts/validation/validate_real_ringdown.py --part all --jobs $(JOBS) \
+	  --out build/validate_real --markdown docs/validation_ringdown_real_tables.md
 
 # Sanitizers (ASan + UBSan): core, tool, core tests and the bad-input suite (scripts/run_asan_tests.sh).
 .PHONY: test-asan fuzz

@@ -16,3 +16,7 @@ mkdir -p build/validate/work
 if [ -f scripts/validate_ringdown.py ]; then
   /usr/bin/python3 scripts/validate_ringdown.py --n 100 --markdown docs/validation_ringdown.md
 fi
+if [ -f scripts/validation/validate_real_ringdown.py ]; then
+  /usr/bin/python3 scripts/validation/validate_real_ringdown.py --part all --jobs "${VALIDATE_JOBS:-2}" \
+    --out build/validate_real --markdown docs/validation_ringdown_real_tables.md
+fi

@@ -28,10 +28,11 @@ records (clean: nothing selected and not unexplained) in >= 95 %; false alarms o
 floor and claimed in <= 5 % of the records without one (every class); the right cause in >= 95 % of
 the causes' records without a floor (these rows were added before the run on base 98106237).
 Rates carry Wilson 95 % intervals. Tuning runs use other seed bases than the reporting run
-(`--seed-base`; the reporting base is the default, 99417733, first used after the real-export
+(`--seed-base`; the reporting base is the default, 99530119, first used after the real-export
 segmentation of 27 Nov (record window, straight stretch, span spread, beat/two-stage Q check) was
-tuned on the real development set and checked on base 41000000; 20261125, 30261125, 71829304,
-88412207, 93517331, 96204411, 97308523 and 98106237 are spent). 100 records a class (and 20 without a floor
+tuned on the real development set, checked on base 41000000, and its floor cut corrected after
+base 99417733 showed 5 beats of 100 cut at a beat dip (beat 0.94 there); 20261125, 30261125,
+71829304, 88412207, 93517331, 96204411, 97308523, 98106237 and 99417733 are spent). 100 records a class (and 20 without a floor
 for each cause): a Wilson interval of about +-0.05 at 0.95.
 
 Usage: validate_ringdown.py [--markdown FILE] [--n N] [--seed-base S] [--classes a,b] [--jobs J]
@@ -573,7 +574,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--markdown")
     ap.add_argument("--n", type=int, default=100, help="records per class")
-    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=99417733,
+    ap.add_argument("--seed-base", "--seed", dest="seed", type=int, default=99530119,
                     help="first seed (the reporting run uses the default; tune on others)")
     ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated subset")
     ap.add_argument("--jobs", type=int, default=int(os.environ.get("VALIDATE_JOBS", "2")))
@@ -715,6 +716,10 @@ def main():
     rc_fail = [r for r in results if r["rc"] != 0]
     times = sorted(r["time"] for r in results)
     md = ["# Ring-down validation (`scripts/validate_ringdown.py`)", "",
+          "Real instrument exports (a development set split by sample, the authors' Q as "
+          "reference, contact sheets of every disagreement read by eye): "
+          "`docs/validation_ringdown_real.md` (`make validate-real`). This page is the generator.",
+          "",
           "Records from an independent NumPy generator that shares no code or closed form with the "
           "fit: the 1-DOF oscillator with the damping law integrated by RK4, driven to steady state "
           "and switched off, read through a simulated lock-in (2-pole low-pass, 0.8 .. 3 cycles) with "

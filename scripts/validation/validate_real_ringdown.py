@@ -95,7 +95,7 @@ def z_rms(results, labels, key):
     return rms, len(zs), lost
 
 
-def contact_sheet(results, labels, out_dir, per=12):
+def contact_sheet(results, labels, out_dir, prefix, per=12):
     import matplotlib
 
     matplotlib.use("Agg")
@@ -140,7 +140,7 @@ def contact_sheet(results, labels, out_dir, per=12):
             ax.set_title(title + " [%s]" % cls, fontsize=6)
             ax.tick_params(labelsize=5)
         fig.tight_layout()
-        name = os.path.join(out_dir, "disagree_%02d.png" % (k // per))
+        name = os.path.join(out_dir, "%s_disagree_%02d.png" % (prefix, k // per))
         fig.savefig(name, dpi=85)
         plt.close(fig)
         names.append(name)
@@ -236,7 +236,7 @@ def main():
         if not a.no_sheet and dis:
             sheet_dir = os.path.join(out, "sheets")
             os.makedirs(sheet_dir, exist_ok=True)
-            for n in contact_sheet(dis, labels, sheet_dir):
+            for n in contact_sheet(dis, labels, sheet_dir, part):
                 P("  sheet: %s" % os.path.relpath(n, rc.REPO))
     text = "\n".join(lines)
     print(text)

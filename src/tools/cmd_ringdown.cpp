@@ -217,6 +217,7 @@ int runRingdownIdentify(const std::vector<std::string>& argv) {
   const RingdownFitOptions fo = fitOptions(args);
   const RingdownSegment seg = segmentRingdown(env, so);
   RingdownFit fit = fitRingdown(env, seg, model, fo);
+  requirePositiveQ(fit, seg);
   addSpanSpread(env, seg, fo, &fit);
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::cout << std::setprecision(6);

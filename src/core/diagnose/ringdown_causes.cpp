@@ -236,7 +236,8 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
       for (size_t i = 0; i < f.fitted.size(); ++i)
         s.effect_db = std::max(s.effect_db, std::fabs(f.fitted[i] - x.baseline.fitted[i]));
       s.effect_db *= 20.0 / std::log(10.0);
-      s.effect_over_rms = s.effect_db / std::max(x.baseline.rms_log * 20.0 / std::log(10.0), 1e-300);
+      s.effect_over_rms =
+          s.effect_db / std::max(x.baseline.rms_log * 20.0 / std::log(10.0), 1e-300);
     }
     x.information_criterion[s.added] = s.information_criterion;
     if (isAmplitudeLaw(s.added)) {
@@ -416,6 +417,7 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     if (ok[k] && steps[k].physical)
       ic_best_physical = std::min(ic_best_physical, steps[k].information_criterion);
   if (!(ic_best_physical - ic_negative_law > options.margin)) negative_law.clear();
+  requirePositiveQ(x.final_fit, x.segment);
   addSpanSpread(env, x.segment, options.fit, &x.final_fit);
   x.lack_of_fit_p = ringdownLackOfFitP(x.final_fit);
   x.lack_of_fit_test =

@@ -141,6 +141,15 @@ RingdownValue scaled(RingdownValue v, double s) {
 
 }  // namespace
 
+void requirePositiveQ(const RingdownFit& fit, const RingdownSegment& seg) {
+  const auto q = fit.derived.find("Q");
+  if (q == fit.derived.end() || (std::isfinite(q->second.value) && q->second.value > 0.0)) return;
+  std::ostringstream m;
+  m << "ring-down: the fitted span does not decay (Q " << q->second.value << " from " << fit.model
+    << " over " << seg.t_start_s << " .. " << seg.t_end_s << " s; " << seg.why << ")";
+  throw AnalysisError(m.str());
+}
+
 std::vector<std::string> RingdownFitOptions::validate() const {
   std::vector<std::string> p;
   if (!(confidence > 0.0 && confidence < 1.0)) p.push_back("confidence must be in (0, 1)");

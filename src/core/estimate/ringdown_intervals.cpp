@@ -196,7 +196,8 @@ RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen
     rho.assign(max_lag + 1, 0.0);
     rho[0] = 1.0;
     L = 0;
-    for (int l = 1; l <= max_lag && std::fabs(std::pow(r1, l)) >= 1e-4; ++l) rho[l] = std::pow(r1, l), L = l;
+    for (int l = 1; l <= max_lag && std::fabs(std::pow(r1, l)) >= 1e-4; ++l)
+      rho[l] = std::pow(r1, l), L = l;
     c = (1.0 + r1) / (1.0 - r1);
     ar1_fallback = true;
   }

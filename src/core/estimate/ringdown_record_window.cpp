@@ -24,10 +24,10 @@ double medianOf(const std::vector<double>& y, long a, long b) {
 }
 
 struct Step {
-  size_t i = 0;         ///< first sample after the step
-  double left = 0.0;    ///< level before [dB]
-  double right = 0.0;   ///< level after [dB]
-  double sharp = 0.0;   ///< jump over the local sd of sample-to-sample differences
+  size_t i = 0;        ///< first sample after the step
+  double left = 0.0;   ///< level before [dB]
+  double right = 0.0;  ///< level after [dB]
+  double sharp = 0.0;  ///< jump over the local sd of sample-to-sample differences
 };
 
 /// Sharp steps of the level y_db (step 1 of the header), in time order.

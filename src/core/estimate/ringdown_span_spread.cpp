@@ -18,7 +18,8 @@ void addSpanSpread(const RingdownEnvelope& env, const RingdownSegment& seg,
     if (fit->derived.count(k)) names.push_back(k);
   std::vector<double> sum2(names.size(), 0.0);
   int used = 0;
-  for (const auto& cut : {std::pair<double, double>{0.1, 0.0}, {0.2, 0.0}, {0.0, 0.1}, {0.0, 0.2}}) {
+  for (const auto& cut :
+       {std::pair<double, double>{0.1, 0.0}, {0.2, 0.0}, {0.0, 0.1}, {0.0, 0.2}}) {
     RingdownSegment s = seg;
     s.i_start = seg.i_start + static_cast<size_t>(cut.first * len);
     s.i_end = seg.i_end - static_cast<size_t>(cut.second * len);

@@ -65,10 +65,14 @@ bool grow(const std::vector<double>& u, const std::vector<double>& sm, size_t a,
 
 std::string StraightSpan::endName() const {
   switch (end) {
-    case StraightSpanEnd::kFloor: return "a noise floor";
-    case StraightSpanEnd::kSmoothRise: return "a slowing decay";
-    case StraightSpanEnd::kFall: return "a faster fall";
-    default: return "the record's end";
+    case StraightSpanEnd::kFloor:
+      return "a noise floor";
+    case StraightSpanEnd::kSmoothRise:
+      return "a slowing decay";
+    case StraightSpanEnd::kFall:
+      return "a faster fall";
+    default:
+      return "the record's end";
   }
 }
 

@@ -29,7 +29,8 @@ Rec make(int n, F level, unsigned seed = 1) {
 }
 
 TEST(RingdownWindow, APlainRecordIsKeptWhole) {
-  const Rec r = make(600, [](double t) { return t < 100 ? 0.0 : std::max(-0.3 * (t - 100), -80.0); });
+  const Rec r =
+      make(600, [](double t) { return t < 100 ? 0.0 : std::max(-0.3 * (t - 100), -80.0); });
   const RingdownWindow w = findRingdownWindow(r.t, r.y);
   EXPECT_EQ(w.first, 0u);
   EXPECT_EQ(w.last, 600u);

@@ -68,7 +68,8 @@ TEST(RingdownStraightSpan, AShortSwitchOffTransientDoesNotWin) {
 }
 
 TEST(RingdownStraightSpan, NoDecayIsNoStretch) {
-  const Rec r = make(300, [](double) { return -40.0; }, 1.0);
+  const Rec r = make(
+      300, [](double) { return -40.0; }, 1.0);
   EXPECT_FALSE(findStraightSpan(r.t, r.y, r.skip).ok);
 }
 

@@ -17,8 +17,8 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <map>
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -98,6 +98,10 @@ struct RingdownFit {
 RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
                         const std::string& model, const RingdownFitOptions& options = {},
                         const std::vector<Eigen::VectorXd>& starts = {});
+
+/// Throws AnalysisError (a refusal, exit 1) when the fitted Q is not positive and finite: the span
+/// does not decay (a real export whose span holds plateaus and steps once gave Q = -1.9e6).
+void requirePositiveQ(const RingdownFit& fit, const RingdownSegment& seg);
 
 /// ln A (file's unit) of a fitted model at time t [s] (any t, e.g. held-out samples).
 double ringdownPredict(const RingdownFit& fit, double t_s);

@@ -1,8 +1,8 @@
 // The longest straight stretch of a ring-down's level in dB (a single exponential), as a person
 // reading a real export would pick it (docs/validation_ringdown.md, "Real records"):
 //  1. The level is reduced to block medians (at most `grid` points) and smoothed by a running
-//     median of 1/300 of them (a switch-off transient of ten samples stays visible); its robust sample-to-sample sd sets the tolerance
-//     tol = max(tol_db, 4 sd).
+//     median of 1/300 of them (a switch-off transient of ten samples stays visible); its robust
+//     sample-to-sample sd sets the tolerance tol = max(tol_db, 4 sd).
 //  2. From each start where the level first falls 1, 2, 3, 5, 8, 12, 17, 23, 30 or 40 dB below
 //     its peak, the first `first_db` of fall must lie on a line within tol; the line is then
 //     extended sample by sample (refitted every tenth of its length) until `run` consecutive
