@@ -87,7 +87,8 @@ RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vecto
   why.precision(4);
   // 3. A record that starts under the drive level.
   const double head = medianOf(sm, 0, std::max<long>(5, n / 50));
-  if (top - head > o.start_below_db) {
+  const bool started_under = top - head > o.start_below_db;
+  if (started_under) {
     size_t j = i_peak;
     while (j > 0 && !(std::isfinite(sm[j - 1]) && sm[j - 1] < top - 0.5 * o.near_top_db)) --j;
     w.first = j;
@@ -142,7 +143,10 @@ RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vecto
   // 5. A long plateau (over plateau_fraction of what follows the switch-off) is cut to that
   // fraction before it: the segmentation reads the drive level from the window's head, and a long
   // plateau that wanders or creeps over the drive-off threshold hides the switch-off.
-  if (w.last > w.first) {
+  // Only in a record that started under the drive level: on the generator's beats the envelope
+  // comes back within off_below_db of the peak after the switch-off, and the cut took the
+  // plateau and the first beats (base 99530119: 3 of 20 beats without a floor).
+  if (w.last > w.first && started_under) {
     size_t i_off = w.first;
     for (size_t i = w.first; i < w.last; ++i)
       if (std::isfinite(sm[i]) && sm[i] >= top - o.off_below_db) i_off = i;

@@ -17,8 +17,8 @@
 //     when it is large (end_step_db) or sharp (end_step_sharpness local sd).
 //  6. (Before 5.) A tail that is noiseless to the record's end (roughness under tail_roughness_db
 //     and 30 times under the stretch before it) is an appended curve: the window ends there.
-//  5. A plateau longer than plateau_fraction of the rest is cut to that length before the last
-//     sample within off_below_db of the peak.
+//  5. In a record that started under the drive level (3), a plateau longer than plateau_fraction
+//     of the rest is cut to that length before the last sample within off_below_db of the peak.
 #pragma once
 
 #include <string>
