@@ -4,6 +4,7 @@ block RLS (2.12) (forgetting factor 1, corrected pairing, docs/paper.md item 9);
 last state equals the batch least-squares estimate the node computes when the replay stops, to
 rounding (relative 1e-8 of each value's standard error scale)."""
 import threading
+import time
 import unittest
 
 import rosbag
@@ -29,7 +30,11 @@ class RlsEqualsBatch(unittest.TestCase):
             if "rls" in got and "ls" in got:
                 done.set()
 
-        rospy.Subscriber("/cvg/estimate", ModelEstimate, on_estimate)
+        sub = rospy.Subscriber("/cvg/estimate", ModelEstimate, on_estimate)
+        # The node publishes the last recursive estimate once; be connected before the replay.
+        deadline = time.monotonic() + timeout  # wall clock: /clock only starts with the replay
+        while sub.get_num_connections() == 0 and time.monotonic() < deadline:
+            time.sleep(0.05)
         player = BagPlayer(bag, ["/cvg/identify"], timeout)
         try:
             finished = done.wait(timeout)
