@@ -19,6 +19,10 @@ int runExplain(const std::vector<std::string>& args);
 int runRingdownIdentify(const std::vector<std::string>& args);
 int runRingdownExplain(const std::vector<std::string>& args);
 int runRingdownSimulate(const std::vector<std::string>& args);
+// `--mode response` of identify / explain / simulate (cmd_response.cpp).
+int runResponseIdentify(const std::vector<std::string>& args);
+int runResponseExplain(const std::vector<std::string>& args);
+int runResponseSimulate(const std::vector<std::string>& args);
 
 }  // namespace tools
 }  // namespace cvg_bench

@@ -20,6 +20,8 @@ const char* kUsage =
     "  explain   INPUT --mode free_decay|forced [--json FILE] [--report DIR]\n"
     "  identify|explain INPUT --mode ringdown [--frequency HZ] ...   single-channel ring-downs\n"
     "  simulate  --mode ringdown --out FILE ...                      (see --mode ringdown --help)\n"
+    "  identify|explain INPUT --mode response [--columns ...] ...   one mode's frequency response\n"
+    "  simulate  --mode response --out FILE ...                      (see --mode response --help)\n"
     "exit status: 0 success, 1 analysis failed, 2 bad usage or input\n";
 
 }  // namespace
@@ -52,6 +54,13 @@ int main(int argc, char** argv) {
         if (it->first == "identify") return runRingdownIdentify(args);
         if (it->first == "explain") return runRingdownExplain(args);
         if (it->first == "simulate") return runRingdownSimulate(args);
+      }
+    // `--mode response`: one mode's frequency response (cmd_response.cpp).
+    for (size_t i = 0; i + 1 < args.size(); ++i)
+      if ((args[i] == "--mode" && args[i + 1] == "response") || args[i] == "--mode=response") {
+        if (it->first == "identify") return runResponseIdentify(args);
+        if (it->first == "explain") return runResponseExplain(args);
+        if (it->first == "simulate") return runResponseSimulate(args);
       }
     return it->second(args);
   } catch (const cvg_bench::InputError& e) {

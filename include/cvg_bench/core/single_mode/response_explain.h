@@ -1,0 +1,43 @@
+// What one mode's response shows besides f0 and Q (docs/response.md): a backbone (`xi`), a width
+// that changes with amplitude (`gamma_nl`, either sign), both, or `unexplained` when the drive
+// levels differ in a way no amplitude law of the model follows (e.g. an amplitude that saturates
+// as the drive grows).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cvg_bench/core/single_mode/response_fit.h"
+
+namespace cvg_bench {
+
+struct ResponseExplainOptions {
+  ResponseFitOptions fit;
+  /// Level of each term's test (two-sided, on the jackknife t of the term in its model).
+  double alpha = 0.01;
+  /// `unexplained` when the selected model's RSS exceeds this many times the RSS of free linear
+  /// Lorentzians per drive level (each level its own f0, width, gain and background).
+  double adequacy_threshold = 2.0;
+};
+
+struct ResponseCandidate {
+  ResponseFit fit;
+  bool significant = false;                ///< every term of the candidate passes its test
+  std::map<std::string, double> p_values;  ///< per term ("xi", "gamma_nl")
+};
+
+struct ResponseExplanation {
+  std::vector<ResponseCandidate> candidates;  ///< linear, xi, gamma_nl, xi+gamma_nl
+  std::string selected;
+  size_t selected_index = 0;
+  bool unexplained = false;
+  double rss_selected = 0.0, rss_free_levels = 0.0, adequacy_ratio = 0.0;
+  double adequacy_threshold = 0.0;
+  std::string adequacy_test;
+  std::string verdict;
+};
+
+ResponseExplanation explainResponse(const ResponseData& data, const ResponseExplainOptions& o);
+
+}  // namespace cvg_bench

@@ -1,0 +1,280 @@
+// Reader and writer of one-mode frequency-response files (response_record.h).
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <ostream>
+#include <sstream>
+
+#include "cvg_bench/core/io/response_record.h"
+#include "cvg_bench/core/model/errors.h"
+
+namespace cvg_bench {
+namespace {
+
+const char* const kKeys[] = {"t", "frequency_hz", "x", "y", "drive", "direction"};
+
+std::string lowerTrimmed(const std::string& s) {
+  size_t a = 0, b = s.size();
+  while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
+  while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
+  std::string out = s.substr(a, b - a);
+  for (auto& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+/// Fields of a data row: split at `,` or `;` when present, else at runs of whitespace (tabs too).
+std::vector<std::string> splitRow(const std::string& line) {
+  std::vector<std::string> out;
+  char sep = 0;
+  if (line.find(',') != std::string::npos) sep = ',';
+  else if (line.find(';') != std::string::npos) sep = ';';
+  if (sep != 0) {
+    std::string cur;
+    for (char c : line) {
+      if (c == sep) {
+        out.push_back(lowerTrimmed(cur));
+        cur.clear();
+      } else {
+        cur += c;
+      }
+    }
+    out.push_back(lowerTrimmed(cur));
+    return out;
+  }
+  std::istringstream ss(line);
+  std::string f;
+  while (ss >> f) out.push_back(lowerTrimmed(f));
+  return out;
+}
+
+bool parseNumber(const std::string& field, double& v) {
+  if (field.empty()) return false;
+  errno = 0;
+  char* end = nullptr;
+  v = std::strtod(field.c_str(), &end);
+  return end != field.c_str() && *end == '\0' && errno != ERANGE;
+}
+
+/// A header cell without a bracketed unit: "x [V]" -> "x".
+std::string headerName(const std::string& cell) {
+  std::string s = cell.substr(0, cell.find('['));
+  s = s.substr(0, s.find('('));
+  return lowerTrimmed(s);
+}
+
+std::string knownKeys() {
+  std::string s;
+  for (const char* k : kKeys) s += std::string(s.empty() ? "" : ", ") + k;
+  return s;
+}
+
+/// "t=1,frequency_hz=2,..." -> key -> 0-based column.
+std::map<std::string, int> parseColumnMap(const std::string& spec) {
+  std::map<std::string, int> out;
+  std::stringstream ss(spec);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    if (item.empty()) continue;
+    const size_t eq = item.find('=');
+    if (eq == std::string::npos)
+      throw InputError("--columns: '" + item + "' is not KEY=N (1-based column number)");
+    const std::string key = lowerTrimmed(item.substr(0, eq));
+    if (std::find(std::begin(kKeys), std::end(kKeys), key) == std::end(kKeys))
+      throw InputError("--columns: unknown key '" + key + "' (known: " + knownKeys() + ")");
+    double n = 0;
+    if (!parseNumber(lowerTrimmed(item.substr(eq + 1)), n) || n < 1 || n != std::floor(n) ||
+        n > 1000)
+      throw InputError("--columns: '" + item + "': the column must be a number from 1");
+    if (!out.emplace(key, static_cast<int>(n) - 1).second)
+      throw InputError("--columns: key '" + key + "' given twice");
+  }
+  for (const char* k : {"frequency_hz", "x", "y"})
+    if (!out.count(k)) throw InputError(std::string("--columns: key '") + k + "' is required");
+  return out;
+}
+
+int directionOf(const std::string& field, double& num) {
+  if (field == "up" || field == "+") return 1;
+  if (field == "down" || field == "-") return -1;
+  if (parseNumber(field, num) && std::isfinite(num)) return num > 0 ? 1 : (num < 0 ? -1 : 0);
+  return 2;  // unparsable
+}
+
+}  // namespace
+
+ResponseKind parseResponseKind(const std::string& s) {
+  if (s == "displacement") return ResponseKind::kDisplacement;
+  if (s == "velocity") return ResponseKind::kVelocity;
+  throw InputError("--response: '" + s + "' is not displacement or velocity");
+}
+
+std::string responseKindName(ResponseKind k) {
+  return k == ResponseKind::kVelocity ? "velocity" : "displacement";
+}
+
+ResponseRecord readResponseText(const std::string& text, const std::string& source,
+                                const std::string& columns) {
+  ResponseRecord rec;
+  rec.source = source;
+  std::map<std::string, int> col;
+  bool have_map = false;
+  if (!columns.empty()) {
+    col = parseColumnMap(columns);
+    have_map = true;
+  }
+  std::istringstream in(text);
+  std::string line;
+  int line_no = 0;
+  bool first_row = true;
+  const std::string where = source + ":";
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::string t = lowerTrimmed(line);
+    if (t.empty()) continue;
+    if (t[0] == '#' || t[0] == '%') {
+      rec.comments.push_back(line.substr(line.find_first_of("#%") + 1));
+      continue;
+    }
+    const std::vector<std::string> fields = splitRow(line);
+    if (first_row) {
+      first_row = false;
+      double v = 0;
+      if (!parseNumber(fields[0], v)) {  // a header row
+        if (have_map)
+          throw InputError(where + std::to_string(line_no) +
+                           ": the file has a header row; --columns is for headerless files");
+        for (size_t i = 0; i < fields.size(); ++i) {
+          const std::string name = headerName(fields[i]);
+          if (std::find(std::begin(kKeys), std::end(kKeys), name) != std::end(kKeys))
+            col.emplace(name, static_cast<int>(i));
+        }
+        for (const char* k : {"frequency_hz", "x", "y"})
+          if (!col.count(k))
+            throw InputError(where + std::to_string(line_no) + ": no column '" + k +
+                             "' in the header (named columns: " + knownKeys() +
+                             "; headerless files: --columns t=1,frequency_hz=2,x=3,y=4,drive=5)");
+        have_map = true;
+        continue;
+      }
+      if (!have_map) {
+        if (fields.size() >= 5) {
+          col = {{"t", 0}, {"frequency_hz", 1}, {"x", 2}, {"y", 3}, {"drive", 4}};
+          rec.notes.push_back(
+              "no header and no --columns: columns read as t, frequency_hz, x, y, drive");
+        } else if (fields.size() == 3) {
+          col = {{"frequency_hz", 0}, {"x", 1}, {"y", 2}};
+          rec.notes.push_back(
+              "no header and no --columns: columns read as frequency_hz, x, y (one drive level)");
+        } else {
+          throw InputError(where + std::to_string(line_no) + ": " +
+                           std::to_string(fields.size()) +
+                           " columns and no header: give --columns t=N,frequency_hz=N,x=N,y=N,"
+                           "drive=N");
+        }
+        have_map = true;
+      }
+    }
+    auto value = [&](const char* key, double& v) {
+      const int c = col.at(key);
+      if (c >= static_cast<int>(fields.size()))
+        throw InputError(where + std::to_string(line_no) + ": no field " + std::to_string(c + 1) +
+                         " (" + key + "); the row has " + std::to_string(fields.size()));
+      if (!parseNumber(fields[c], v) || !std::isfinite(v))
+        throw InputError(where + std::to_string(line_no) + ": field " + std::to_string(c + 1) +
+                         " (" + key + ") is not a finite number: '" + fields[c] + "'");
+    };
+    double f = 0, x = 0, y = 0, d = 1.0, tt = static_cast<double>(rec.size());
+    value("frequency_hz", f);
+    value("x", x);
+    value("y", y);
+    if (col.count("drive")) value("drive", d);
+    if (col.count("t")) value("t", tt);
+    if (!(f > 0))
+      throw InputError(where + std::to_string(line_no) + ": frequency_hz must be > 0, got " +
+                       fields[col.at("frequency_hz")]);
+    if (!(d > 0))
+      throw InputError(where + std::to_string(line_no) +
+                       ": drive must be > 0 (a drive level per point), got " +
+                       fields[col.at("drive")]);
+    if (!rec.t_s.empty() && !(tt > rec.t_s.back()))
+      throw InputError(where + std::to_string(line_no) +
+                       ": time must increase (the file is read in time order), got " +
+                       std::to_string(tt) + " after " + std::to_string(rec.t_s.back()));
+    if (col.count("direction")) {
+      const int c = col.at("direction");
+      double num = 0;
+      const int dir = c < static_cast<int>(fields.size()) ? directionOf(fields[c], num) : 2;
+      if (dir == 2)
+        throw InputError(where + std::to_string(line_no) + ": field " + std::to_string(c + 1) +
+                         " (direction) must be up/down or a signed number");
+      rec.direction.push_back(dir);
+    }
+    rec.t_s.push_back(tt);
+    rec.frequency_hz.push_back(f);
+    rec.x.push_back(x);
+    rec.y.push_back(y);
+    rec.drive.push_back(d);
+  }
+  rec.has_time = col.count("t") > 0;
+  if (!col.count("drive") && rec.size() > 0)
+    rec.notes.push_back("no drive column: one drive level (1) assumed");
+  if (rec.size() < 8)
+    throw InputError(source + ": " + std::to_string(rec.size()) +
+                     " response points; a one-mode fit needs at least 8");
+  return rec;
+}
+
+ResponseRecord readResponseFile(const std::string& path, const std::string& columns) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return readResponseText(ss.str(), path, columns);
+}
+
+void writeResponseCsv(const ResponseRecord& r, std::ostream& out) {
+  for (const auto& c : r.comments) out << "#" << c << "\n";
+  out << "t,frequency_hz,x,y,drive\n" << std::setprecision(12);
+  for (size_t i = 0; i < r.size(); ++i)
+    out << r.t_s[i] << "," << r.frequency_hz[i] << "," << r.x[i] << "," << r.y[i] << ","
+        << r.drive[i] << "\n";
+}
+
+std::vector<int> splitSweeps(const ResponseRecord& r) {
+  const size_t n = r.size();
+  std::vector<int> id(n, 0);
+  if (n == 0) return id;
+  std::vector<double> dt;
+  for (size_t i = 1; i < n; ++i) dt.push_back(r.t_s[i] - r.t_s[i - 1]);
+  double median_dt = 0;
+  if (!dt.empty()) {
+    std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+    median_dt = dt[dt.size() / 2];
+  }
+  int sweep = 0;
+  int step_sign = 0;  // sign of the frequency steps of the current sweep (0: not yet known)
+  for (size_t i = 1; i < n; ++i) {
+    const double df = r.frequency_hz[i] - r.frequency_hz[i - 1];
+    const int s = df > 0 ? 1 : (df < 0 ? -1 : 0);
+    bool cut = std::abs(r.drive[i] - r.drive[i - 1]) > 1e-6 * std::abs(r.drive[i - 1]);
+    cut = cut || (s != 0 && step_sign != 0 && s != step_sign);
+    cut = cut || (!r.direction.empty() && r.direction[i] != r.direction[i - 1]);
+    cut = cut || (median_dt > 0 && r.t_s[i] - r.t_s[i - 1] > 20.0 * median_dt);
+    if (cut) {
+      ++sweep;
+      step_sign = 0;
+    } else if (s != 0) {
+      step_sign = s;
+    }
+    id[i] = sweep;
+  }
+  return id;
+}
+
+}  // namespace cvg_bench

@@ -1,0 +1,506 @@
+// Output-error fit of one mode's response (response_fit.h). The fit runs in normalised units
+// (response / its largest magnitude, drive / its largest level) and converts back at the end.
+#include "cvg_bench/core/single_mode/response_fit.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/model/errors.h"
+
+namespace cvg_bench {
+namespace {
+
+using cd = std::complex<double>;
+
+/// Parameter vector: f0, w0, Re a, Im a, Re b0, Im b0, [Re b1, Im b1], [xi], [g].
+struct Layout {
+  bool slope = false, xi = false, g = false;
+  int size() const { return 6 + (slope ? 2 : 0) + (xi ? 1 : 0) + (g ? 1 : 0); }
+};
+
+ResponseParams unpack(const double* x, const Layout& L, double f_ref) {
+  ResponseParams p;
+  p.f0_hz = x[0];
+  p.width_hz = x[1];
+  p.gain = cd(x[2], x[3]);
+  p.bg0 = cd(x[4], x[5]);
+  int k = 6;
+  if (L.slope) {
+    p.bg1 = cd(x[k], x[k + 1]);
+    k += 2;
+  }
+  if (L.xi) p.backbone_hz_per_amp2 = x[k++];
+  if (L.g) p.width_growth_hz_per_amp2 = x[k++];
+  p.f_ref_hz = f_ref;
+  return p;
+}
+
+std::vector<double> pack(const ResponseParams& p, const Layout& L) {
+  std::vector<double> x = {p.f0_hz,        p.width_hz,     p.gain.real(),
+                           p.gain.imag(),  p.bg0.real(),   p.bg0.imag()};
+  if (L.slope) {
+    x.push_back(p.bg1.real());
+    x.push_back(p.bg1.imag());
+  }
+  if (L.xi) x.push_back(p.backbone_hz_per_amp2);
+  if (L.g) x.push_back(p.width_growth_hz_per_amp2);
+  return x;
+}
+
+struct OutputError {
+  const ResponseData* data;
+  Layout layout;
+  double f_ref;
+  bool operator()(double const* const* x, double* r) const {
+    const ResponseParams p = unpack(x[0], layout, f_ref);
+    if (!(p.f0_hz > 0.0) || !(p.width_hz > 0.0)) return false;
+    const std::vector<cd> m = stationaryResponse(p, *data);
+    for (size_t i = 0; i < m.size(); ++i) {
+      const cd e = data->z[i] - m[i];
+      r[2 * i] = e.real();
+      r[2 * i + 1] = e.imag();
+      if (!std::isfinite(r[2 * i]) || !std::isfinite(r[2 * i + 1])) return false;
+    }
+    return true;
+  }
+};
+
+double costOf(const ResponseParams& p, const ResponseData& d) {
+  const std::vector<cd> m = stationaryResponse(p, d);
+  double s = 0.0;
+  for (size_t i = 0; i < m.size(); ++i) s += std::norm(d.z[i] - m[i]);
+  return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
+}
+
+/// Levenberg-Marquardt (Ceres, central differences) from `start`; returns the final parameters.
+ResponseParams refine(const ResponseData& d, const Layout& L, const ResponseParams& start,
+                      int max_iterations, bool* converged) {
+  std::vector<double> x = pack(start, L);
+  auto* cost = new ceres::DynamicNumericDiffCostFunction<OutputError, ceres::CENTRAL>(
+      new OutputError{&d, L, start.f_ref_hz});
+  cost->AddParameterBlock(L.size());
+  cost->SetNumResiduals(static_cast<int>(2 * d.size()));
+  ceres::Problem problem;
+  problem.AddResidualBlock(cost, nullptr, x.data());
+  ceres::Solver::Options o;
+  o.linear_solver_type = ceres::DENSE_QR;
+  o.max_num_iterations = max_iterations;
+  o.function_tolerance = 1e-12;
+  o.parameter_tolerance = 1e-12;
+  o.gradient_tolerance = 1e-14;
+  o.logging_type = ceres::SILENT;
+  o.num_threads = 1;
+  ceres::Solver::Summary s;
+  ceres::Solve(o, &problem, &s);
+  if (converged) *converged = s.IsSolutionUsable();
+  return unpack(x.data(), L, start.f_ref_hz);
+}
+
+/// Linear model at fixed f0, w: the complex gain and background by QR; returns the RSS.
+double projectLinear(const ResponseData& d, const std::vector<int>& idx, double f0, double w,
+                     bool slope, double f_ref, ResponseParams* out) {
+  const int k = slope ? 3 : 2;
+  Eigen::MatrixXcd A(idx.size(), k);
+  Eigen::VectorXcd b(idx.size());
+  for (size_t r = 0; r < idx.size(); ++r) {
+    const int i = idx[r];
+    const double f = d.frequency_hz[i];
+    const cd S = d.kind == ResponseKind::kVelocity ? cd(f / f0, 0.0) : cd(1.0, 0.0);
+    A(r, 0) = d.drive[i] * S / cd(f0 * f0 - f * f, f * w);
+    A(r, 1) = d.drive[i];
+    if (slope) A(r, 2) = d.drive[i] * (f - f_ref);
+    b(r) = d.z[i];
+  }
+  const Eigen::VectorXcd beta = A.colPivHouseholderQr().solve(b);
+  const double rss = (A * beta - b).squaredNorm();
+  if (out) {
+    out->f0_hz = f0;
+    out->width_hz = w;
+    out->gain = beta(0);
+    out->bg0 = beta(1);
+    out->bg1 = slope ? beta(2) : cd(0.0, 0.0);
+    out->f_ref_hz = f_ref;
+    out->backbone_hz_per_amp2 = out->width_growth_hz_per_amp2 = 0.0;
+  }
+  return std::isfinite(rss) ? rss : std::numeric_limits<double>::infinity();
+}
+
+/// Variable projection over a grid of f0 and w (then a finer grid around the best cell).
+double gridLinear(const ResponseData& d, const std::vector<int>& idx, bool slope, double f_ref,
+                  ResponseParams* best) {
+  double fmin = std::numeric_limits<double>::infinity(), fmax = -fmin, step = fmax;
+  for (size_t r = 0; r < idx.size(); ++r) {
+    fmin = std::min(fmin, d.frequency_hz[idx[r]]);
+    fmax = std::max(fmax, d.frequency_hz[idx[r]]);
+    if (r > 0) {
+      const double df = std::abs(d.frequency_hz[idx[r]] - d.frequency_hz[idx[r - 1]]);
+      if (df > 0) step = std::min(step, df);
+    }
+  }
+  const double span = std::max(fmax - fmin, 1e-9 * fmax);
+  if (!std::isfinite(step)) step = span;
+  double lo_f = fmin - 0.1 * span, hi_f = fmax + 0.1 * span;
+  double lo_w = std::max(0.3 * step, span * 1e-4), hi_w = 3.0 * span;
+  double best_rss = std::numeric_limits<double>::infinity();
+  double bf = 0.5 * (fmin + fmax), bw = std::sqrt(lo_w * hi_w);
+  for (int pass = 0; pass < 3; ++pass) {
+    const int nf = pass == 0 ? 60 : 21, nw = pass == 0 ? 30 : 21;
+    for (int a = 0; a < nf; ++a) {
+      const double f0 = lo_f + (hi_f - lo_f) * a / (nf - 1);
+      if (!(f0 > 0)) continue;
+      for (int b = 0; b < nw; ++b) {
+        const double w = lo_w * std::pow(hi_w / lo_w, static_cast<double>(b) / (nw - 1));
+        const double rss = projectLinear(d, idx, f0, w, slope, f_ref, nullptr);
+        if (rss < best_rss) {
+          best_rss = rss;
+          bf = f0;
+          bw = w;
+        }
+      }
+    }
+    const double df = (hi_f - lo_f) / (nf - 1), rw = std::pow(hi_w / lo_w, 1.0 / (nw - 1));
+    lo_f = bf - 2 * df;
+    hi_f = bf + 2 * df;
+    lo_w = bw / (rw * rw);
+    hi_w = bw * rw * rw;
+  }
+  return projectLinear(d, idx, bf, bw, slope, f_ref, best);
+}
+
+double lag1Along(const ResponseData& d, const std::vector<cd>& m) {
+  double num = 0, den = 0;
+  for (size_t i = 0; i < d.size(); ++i) {
+    const cd e = d.z[i] - m[i];
+    den += std::norm(e);
+    if (i > 0 && d.sweep[i] == d.sweep[i - 1]) num += std::real(e * std::conj(d.z[i - 1] - m[i - 1]));
+  }
+  return den > 0 ? num / den : 0.0;
+}
+
+/// Derived quantities in the input's units: f0_hz, width_hz, Q and the nonlinear terms.
+std::map<std::string, double> derivedOf(const ResponseParams& p, const Layout& L, double u_scale) {
+  std::map<std::string, double> v = {
+      {"f0_hz", p.f0_hz}, {"width_hz", p.width_hz}, {"Q", p.f0_hz / p.width_hz}};
+  if (L.xi) v["backbone_hz_per_amp2"] = p.backbone_hz_per_amp2 / u_scale;
+  if (L.g) v["width_growth_hz_per_amp2"] = p.width_growth_hz_per_amp2 / u_scale;
+  return v;
+}
+
+ResponseData subset(const ResponseData& d, const std::vector<int>& idx) {
+  ResponseData s;
+  s.kind = d.kind;
+  for (int i : idx) {
+    s.frequency_hz.push_back(d.frequency_hz[i]);
+    s.drive.push_back(d.drive[i]);
+    s.z.push_back(d.z[i]);
+    s.sweep.push_back(d.sweep[i]);
+  }
+  return s;
+}
+
+/// Numerical Jacobian (central differences) of the stacked residuals at x.
+Eigen::MatrixXd jacobianAt(const ResponseData& d, const Layout& L, double f_ref,
+                           const std::vector<double>& x) {
+  const OutputError fn{&d, L, f_ref};
+  const int n = static_cast<int>(2 * d.size());
+  Eigen::MatrixXd J(n, L.size());
+  std::vector<double> rp(n), rm(n);
+  for (int j = 0; j < L.size(); ++j) {
+    std::vector<double> xp = x, xm = x;
+    const double h = 1e-6 * std::max(std::abs(x[j]), j < 2 ? 1e-3 * std::abs(x[0]) : 1e-6);
+    xp[j] += h;
+    xm[j] -= h;
+    const double* pp = xp.data();
+    const double* pm = xm.data();
+    if (!fn(&pp, rp.data()) || !fn(&pm, rm.data())) return Eigen::MatrixXd();
+    for (int i = 0; i < n; ++i) J(i, j) = (rp[i] - rm[i]) / (2 * h);
+  }
+  return J;
+}
+
+const char* const kParamNames[] = {"f0_hz", "width_hz", "gain", "gain", "background",
+                                   "background"};
+
+}  // namespace
+
+ResponseData responseDataOf(const ResponseRecord& r, ResponseKind kind) {
+  ResponseData d;
+  d.kind = kind;
+  d.frequency_hz = r.frequency_hz;
+  d.drive = r.drive;
+  d.sweep = splitSweeps(r);
+  for (size_t i = 0; i < r.size(); ++i) d.z.emplace_back(r.x[i], r.y[i]);
+  return d;
+}
+
+ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
+                        const ResponseFitOptions& o) {
+  const size_t n = data_in.size();
+  if (n < 8) throw AnalysisError("fewer than 8 response points");
+  ResponseFit fit;
+  fit.terms = terms;
+  fit.kind = o.kind;
+  // Normalise: response by its largest magnitude, drive by its largest level.
+  double zs = 0, ds = 0;
+  for (size_t i = 0; i < n; ++i) {
+    zs = std::max(zs, std::abs(data_in.z[i]));
+    ds = std::max(ds, data_in.drive[i]);
+  }
+  if (!(zs > 0) || !(ds > 0)) throw AnalysisError("the response is zero everywhere");
+  ResponseData d = data_in;
+  d.kind = o.kind;
+  for (size_t i = 0; i < n; ++i) {
+    d.z[i] /= zs;
+    d.drive[i] /= ds;
+  }
+  std::vector<int> all(n);
+  std::iota(all.begin(), all.end(), 0);
+  const double f_ref = 0.5 * (*std::min_element(d.frequency_hz.begin(), d.frequency_hz.end()) +
+                              *std::max_element(d.frequency_hz.begin(), d.frequency_hz.end()));
+  // The lock-in's phase convention: the response turns one way through the resonance.
+  ResponseParams lin, lin_conj;
+  const double rss_direct = gridLinear(d, all, true, f_ref, &lin);
+  ResponseData dc = d;
+  for (auto& z : dc.z) z = std::conj(z);
+  const double rss_conj = gridLinear(dc, all, true, f_ref, &lin_conj);
+  if (rss_conj < rss_direct) {
+    fit.conjugated = true;
+    d = dc;
+    lin = lin_conj;
+    fit.notes.push_back(
+        "phase convention: the response's phase falls through the resonance with y as written "
+        "taken as -Im (lock-in y = -quadrature); the fit used x - iy, results are independent of it");
+  } else {
+    fit.notes.push_back(
+        "phase convention: x + iy with the phase of a displacement-like response falling by pi "
+        "through the resonance (lock-in y = +quadrature)");
+  }
+  // Background slope in frequency only where the data ask for it (F test, lag-1 deflated dof).
+  Layout L;
+  L.xi = terms.backbone;
+  L.g = terms.width_growth;
+  {
+    ResponseParams no_slope;
+    const double rss0 = gridLinear(d, all, false, f_ref, &no_slope);
+    const double rss1 = projectLinear(d, all, lin.f0_hz, lin.width_hz, true, f_ref, &lin);
+    const double rho = std::max(0.0, std::min(0.95, lag1Along(d, stationaryResponse(lin, d))));
+    const double dof = std::max(4.0, (2.0 * n - 8) * (1 - rho) / (1 + rho));
+    const double F = (rss0 - rss1) / 2.0 / (rss1 / dof);
+    L.slope = terms.background_slope || F > 15.0;  // ~p < 1e-6 for F(2, dof large)
+    if (!L.slope) lin = no_slope;
+  }
+  fit.notes.push_back(L.slope ? "background: constant + linear in frequency, per unit drive"
+                              : "background: constant per unit drive (a slope was not needed)");
+  // Per-drive-level Lorentzians: the nonlinear start and the adequacy reference.
+  std::map<double, std::vector<int>> by_level;
+  for (size_t i = 0; i < n; ++i) by_level[d.drive[i]].push_back(static_cast<int>(i));
+  for (const auto& kv : by_level) {
+    if (kv.second.size() < 8) continue;
+    ResponseParams p;
+    ResponseLevelFit lf;
+    lf.rss = gridLinear(d, kv.second, L.slope, f_ref, &p) * zs * zs;
+    lf.drive = kv.first * ds;
+    lf.f0_hz = p.f0_hz;
+    lf.width_hz = p.width_hz;
+    lf.peak_u = std::norm(kv.first * p.gain / cd(0.0, p.f0_hz * p.width_hz));
+    lf.n_points = static_cast<int>(kv.second.size());
+    fit.levels.push_back(lf);
+  }
+  fit.n_drive_levels = static_cast<int>(by_level.size());
+  // Starts: the linear fit, and for nonlinear terms the per-level trend of f0 and width in u.
+  std::vector<ResponseParams> starts = {lin};
+  if ((L.xi || L.g) && fit.levels.size() >= 2) {
+    double su = 0, sf = 0, sw = 0, suu = 0, suf = 0, suw = 0;
+    const double m = static_cast<double>(fit.levels.size());
+    for (const auto& lf : fit.levels) {
+      su += lf.peak_u;
+      sf += lf.f0_hz;
+      sw += lf.width_hz;
+      suu += lf.peak_u * lf.peak_u;
+      suf += lf.peak_u * lf.f0_hz;
+      suw += lf.peak_u * lf.width_hz;
+    }
+    const double den = m * suu - su * su;
+    if (den > 0) {
+      ResponseParams s = lin;
+      const double xi = (m * suf - su * sf) / den, g = (m * suw - su * sw) / den;
+      s.f0_hz = (sf - xi * su) / m;
+      s.width_hz = std::max((sw - g * su) / m, 0.2 * fit.levels.front().width_hz);
+      projectLinear(d, all, s.f0_hz, s.width_hz, L.slope, f_ref, &s);
+      if (L.xi) s.backbone_hz_per_amp2 = xi;
+      if (L.g) s.width_growth_hz_per_amp2 = g;
+      starts.push_back(s);
+      if (L.xi) {  // the same trend read as a backbone of the other sign
+        ResponseParams t = s;
+        t.backbone_hz_per_amp2 = -xi;
+        starts.push_back(t);
+      }
+    }
+  }
+  double best_cost = std::numeric_limits<double>::infinity();
+  ResponseParams best = lin;
+  for (const ResponseParams& s : starts) {
+    bool ok = false;
+    const ResponseParams p = refine(d, L, s, 300, &ok);
+    const double c = costOf(p, d);
+    if (ok && c < best_cost) {
+      best_cost = c;
+      best = p;
+      fit.converged = true;
+    }
+  }
+  if (!fit.converged || !(best.width_hz > 0)) throw AnalysisError("the response fit did not converge");
+  // Statistics in the input's units.
+  std::vector<cd> m = stationaryResponse(best, d, &fit.u, &fit.jumps);
+  fit.residual_lag1 = lag1Along(d, m);
+  fit.n_points = static_cast<int>(n);
+  fit.n_params = L.size();
+  fit.n_sweeps = d.sweep.empty() ? 1 : *std::max_element(d.sweep.begin(), d.sweep.end()) + 1;
+  fit.rss = best_cost * zs * zs;
+  fit.sigma = std::sqrt(fit.rss / std::max(1, static_cast<int>(2 * n) - L.size()));
+  for (auto& z : m) z = (fit.conjugated ? std::conj(z) : z) * zs;
+  fit.model = m;
+  for (auto& u : fit.u) u *= zs * zs;
+  fit.params = best;
+  fit.params.gain *= zs / ds;
+  fit.params.bg0 *= zs / ds;
+  fit.params.bg1 *= zs / ds;
+  fit.params.backbone_hz_per_amp2 /= zs * zs;
+  fit.params.width_growth_hz_per_amp2 /= zs * zs;
+  const std::map<std::string, double> point = derivedOf(best, L, zs * zs);
+  for (const auto& kv : point) fit.derived[kv.first].value = kv.second;
+  if (!o.intervals) return fit;
+
+  // What the data cannot determine: near-null directions of the column-scaled Jacobian.
+  const std::vector<double> x = pack(best, L);
+  const Eigen::MatrixXd J = jacobianAt(d, L, f_ref, x);
+  if (J.size() == 0) throw AnalysisError("the fitted response cannot be evaluated near the optimum");
+  Eigen::VectorXd scale = J.colwise().norm();
+  for (int j = 0; j < scale.size(); ++j) scale(j) = scale(j) > 0 ? scale(j) : 1.0;
+  const Eigen::MatrixXd Js = J * scale.cwiseInverse().asDiagonal();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd sv = svd.singularValues();
+  std::vector<bool> weak(L.size(), false);
+  for (int k = 0; k < sv.size(); ++k) {
+    if (sv(k) > o.rank_tolerance * 1e3 * sv(0)) continue;
+    for (int j = 0; j < L.size(); ++j)
+      if (std::abs(svd.matrixV()(j, k)) > 0.3) weak[j] = true;
+  }
+  std::vector<std::string> weak_derived;
+  {
+    int k = 6 + (L.slope ? 2 : 0);
+    if (weak[0]) weak_derived.push_back("f0_hz");
+    if (weak[1]) weak_derived.push_back("width_hz");
+    if (weak[0] || weak[1]) weak_derived.push_back("Q");
+    if (L.xi && weak[k++]) weak_derived.push_back("backbone_hz_per_amp2");
+    if (L.g && weak[k]) weak_derived.push_back("width_growth_hz_per_amp2");
+    for (int j = 2; j < 6; ++j)
+      if (weak[j]) fit.notes.push_back(std::string(kParamNames[j]) + " is not determined");
+  }
+  fit.not_determined = weak_derived;
+
+  // Intervals: jackknife over whole sweeps, or a within-sweep Bartlett sandwich.
+  std::map<std::string, std::vector<double>> reps;
+  int G = fit.n_sweeps;
+  if (G >= o.min_sweeps_for_jackknife) {
+    int used = 0;
+    for (int g = 0; g < G; ++g) {
+      std::vector<int> keep;
+      for (size_t i = 0; i < n; ++i)
+        if (d.sweep[i] != g) keep.push_back(static_cast<int>(i));
+      const ResponseData dg = subset(d, keep);
+      bool ok = false;
+      const ResponseParams pg = refine(dg, L, best, 100, &ok);
+      if (!ok || !(pg.width_hz > 0)) continue;
+      ++used;
+      for (const auto& kv : derivedOf(pg, L, zs * zs)) reps[kv.first].push_back(kv.second);
+    }
+    fit.interval_dof = std::max(1, used - 1);
+    const double t = studentQuantile(o.confidence, fit.interval_dof);
+    for (auto& kv : reps) {
+      const auto& v = kv.second;
+      const double mean = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+      double ss = 0;
+      for (double a : v) ss += (a - mean) * (a - mean);
+      const double sd = std::sqrt(ss * (v.size() - 1.0) / v.size());
+      ResponseValue& rv = fit.derived[kv.first];
+      rv.std = sd;
+      rv.ci_low = rv.value - t * sd;
+      rv.ci_high = rv.value + t * sd;
+    }
+    fit.interval_method = "jackknife over whole sweeps (" + std::to_string(used) + " of " +
+                          std::to_string(G) + " refits), Student t with " +
+                          std::to_string(std::max(1, used - 1)) + " dof";
+    if (used < G)
+      fit.notes.push_back(std::to_string(G - used) + " jackknife refits did not converge");
+  } else {
+    // Sandwich: cov = Jp K Jp', Jp the pseudo-inverse of J, K the residual products within a
+    // sweep weighted by a Bartlett kernel over point lags (bandwidth 4 (m/100)^(2/9)).
+    const Eigen::MatrixXd Jp = svd.matrixV() *
+                               sv.unaryExpr([&](double s) {
+                                   return s > o.rank_tolerance * sv(0) ? 1.0 / s : 0.0;
+                                 }).asDiagonal() *
+                               svd.matrixU().transpose();
+    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(L.size(), L.size());
+    const std::vector<cd> mn = stationaryResponse(best, d);
+    size_t start = 0;
+    while (start < n) {
+      size_t end = start;
+      while (end < n && d.sweep[end] == d.sweep[start]) ++end;
+      const int mlen = static_cast<int>(end - start);
+      const int bw = static_cast<int>(std::ceil(4.0 * std::pow(mlen / 100.0, 2.0 / 9.0)));
+      Eigen::MatrixXd S(L.size(), mlen);  // score of each point (both components)
+      for (int i = 0; i < mlen; ++i) {
+        const size_t pi = start + i;
+        const cd e = d.z[pi] - mn[pi];
+        S.col(i) = Jp.col(2 * pi) * e.real() + Jp.col(2 * pi + 1) * e.imag();
+      }
+      for (int lag = 0; lag <= std::min(bw, mlen - 1); ++lag) {
+        const double wgt = lag == 0 ? 1.0 : 1.0 - lag / (bw + 1.0);
+        Eigen::MatrixXd P = S.leftCols(mlen - lag) * S.rightCols(mlen - lag).transpose();
+        cov += lag == 0 ? P : Eigen::MatrixXd(wgt * (P + P.transpose()));
+      }
+      start = end;
+    }
+    cov = scale.cwiseInverse().asDiagonal() * cov * scale.cwiseInverse().asDiagonal();
+    fit.interval_dof = std::max(1, static_cast<int>(2 * n) - L.size());
+    const double t = studentQuantile(o.confidence, fit.interval_dof);
+    auto setCi = [&](const std::string& key, const Eigen::VectorXd& grad) {
+      ResponseValue& rv = fit.derived[key];
+      rv.std = std::sqrt(std::max(0.0, grad.dot(cov * grad)));
+      rv.ci_low = rv.value - t * rv.std;
+      rv.ci_high = rv.value + t * rv.std;
+    };
+    Eigen::VectorXd g0 = Eigen::VectorXd::Zero(L.size()), g1 = g0, gq = g0;
+    g0(0) = 1;
+    g1(1) = 1;
+    gq(0) = 1.0 / best.width_hz;
+    gq(1) = -best.f0_hz / (best.width_hz * best.width_hz);
+    setCi("f0_hz", g0);
+    setCi("width_hz", g1);
+    setCi("Q", gq);
+    int k = 6 + (L.slope ? 2 : 0);
+    if (L.xi) {
+      Eigen::VectorXd gx = Eigen::VectorXd::Zero(L.size());
+      gx(k++) = 1.0 / (zs * zs);
+      setCi("backbone_hz_per_amp2", gx);
+    }
+    if (L.g) {
+      Eigen::VectorXd gg = Eigen::VectorXd::Zero(L.size());
+      gg(k) = 1.0 / (zs * zs);
+      setCi("width_growth_hz_per_amp2", gg);
+    }
+    fit.interval_method =
+        "sandwich with a Bartlett kernel within each sweep (" + std::to_string(G) +
+        " sweeps: too few for a jackknife over sweeps), Student t";
+  }
+  return fit;
+}
+
+}  // namespace cvg_bench
