@@ -72,7 +72,8 @@ nlohmann::json responseExplanationToJson(const ResponseExplanation& x, double co
                          {"rss", num(c.fit.rss)},
                          {"jumps", c.fit.jumps},
                          {"significant", c.significant},
-                         {"p_values", c.p_values}};
+                         {"p_values", c.p_values},
+                         {"effect_over_width", c.effect_over_width}};
     nlohmann::json dci = nlohmann::json::object();
     for (const auto& kv : c.fit.derived)
       dci[kv.first] = {{"value", num(kv.second.value)},

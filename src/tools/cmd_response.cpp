@@ -4,6 +4,7 @@
 // core/simulate/response_simulator.h.
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -112,9 +113,11 @@ void writeReport(const std::string& dir, const nlohmann::json& j, const Response
   report::writeJsonFile(j, dir + "/explain.json");
   std::ofstream out(dir + "/response_points.csv");
   out << std::setprecision(12) << "t,frequency_hz,drive,sweep,x,y";
-  for (const auto& c : x.candidates)
-    out << ",x_" << c.fit.terms.name() << ",y_" << c.fit.terms.name() << ",u_"
-        << c.fit.terms.name();
+  for (const auto& c : x.candidates) {
+    std::string name = c.fit.terms.name();
+    std::replace(name.begin(), name.end(), '+', '_');  // xi+gamma_nl -> xi_gamma_nl
+    out << ",x_" << name << ",y_" << name << ",u_" << name;
+  }
   out << "\n";
   for (size_t i = 0; i < r.size(); ++i) {
     out << r.t_s[i] << "," << r.frequency_hz[i] << "," << r.drive[i] << "," << d.sweep[i] << ","
@@ -171,7 +174,9 @@ int runResponseExplain(const std::vector<std::string>& argv) {
   for (const auto& c : x.candidates) {
     std::cout << "candidate " << std::setw(12) << std::left << c.fit.terms.name() << " rss "
               << c.fit.rss;
-    for (const auto& p : c.p_values) std::cout << "  p(" << p.first << ") " << p.second;
+    for (const auto& p : c.p_values)
+      std::cout << "  p(" << p.first << ") " << p.second << " effect/width "
+                << c.effect_over_width.at(p.first);
     std::cout << "\n";
   }
   std::cout << "selected: " << x.selected << (x.unexplained ? " (unexplained)" : "") << "\n"

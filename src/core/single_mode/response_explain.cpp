@@ -10,6 +10,7 @@ namespace cvg_bench {
 namespace {
 
 const char* const kTermKey[] = {"backbone_hz_per_amp2", "width_growth_hz_per_amp2"};
+const char* const kTermName[] = {"xi", "gamma_nl"};
 
 /// Two-sided p of a term from its interval's t (value / std, the fit's dof); 1 when the data
 /// cannot determine it.
@@ -41,8 +42,17 @@ ResponseExplanation explainResponse(const ResponseData& data, const ResponseExpl
     ResponseCandidate c;
     c.fit = fitResponse(data, t, o.fit);
     bool all = true;
-    if (t.backbone) all = (c.p_values["xi"] = termP(c.fit, 0)) < o.alpha && all;
-    if (t.width_growth) all = (c.p_values["gamma_nl"] = termP(c.fit, 1)) < o.alpha && all;
+    const double u_max =
+        c.fit.u.empty() ? 0.0 : *std::max_element(c.fit.u.begin(), c.fit.u.end());
+    const double w = c.fit.derived.at("width_hz").value;
+    for (int term = 0; term < 2; ++term) {
+      if (!(term == 0 ? t.backbone : t.width_growth)) continue;
+      const double p = termP(c.fit, term);
+      const double effect = std::abs(c.fit.derived.at(kTermKey[term]).value) * u_max / w;
+      c.p_values[kTermName[term]] = p;
+      c.effect_over_width[kTermName[term]] = effect;
+      all = all && p < o.alpha && effect >= o.min_effect_over_width;
+    }
     c.significant = all && (t.backbone || t.width_growth);
     x.candidates.push_back(c);
   }

@@ -57,12 +57,17 @@ struct OutputError {
   const ResponseData* data;
   Layout layout;
   double f_ref;
+  BranchChoice choice = BranchChoice::kFollow;
+  double huber_delta = 0.0;  ///< > 0: Huber weights on |Z - model| (points off the model's branch)
   bool operator()(double const* const* x, double* r) const {
     const ResponseParams p = unpack(x[0], layout, f_ref);
     if (!(p.f0_hz > 0.0) || !(p.width_hz > 0.0)) return false;
-    const std::vector<cd> m = stationaryResponse(p, *data);
+    const std::vector<cd> m = stationaryResponse(p, *data, nullptr, nullptr, choice);
     for (size_t i = 0; i < m.size(); ++i) {
-      const cd e = data->z[i] - m[i];
+      cd e = data->z[i] - m[i];
+      const double a = std::abs(e);
+      if (huber_delta > 0.0 && a > huber_delta)
+        e *= std::sqrt(2.0 * huber_delta / a - huber_delta * huber_delta / (a * a));
       r[2 * i] = e.real();
       r[2 * i + 1] = e.imag();
       if (!std::isfinite(r[2 * i]) || !std::isfinite(r[2 * i + 1])) return false;
@@ -71,19 +76,24 @@ struct OutputError {
   }
 };
 
-double costOf(const ResponseParams& p, const ResponseData& d) {
+/// Sum of rho(|Z - model|): squares, or Huber beyond delta (> 0).
+double costOf(const ResponseParams& p, const ResponseData& d, double delta = 0.0) {
   const std::vector<cd> m = stationaryResponse(p, d);
   double s = 0.0;
-  for (size_t i = 0; i < m.size(); ++i) s += std::norm(d.z[i] - m[i]);
+  for (size_t i = 0; i < m.size(); ++i) {
+    const double a = std::abs(d.z[i] - m[i]);
+    s += delta > 0.0 && a > delta ? 2.0 * delta * a - delta * delta : a * a;
+  }
   return std::isfinite(s) ? s : std::numeric_limits<double>::infinity();
 }
 
 /// Levenberg-Marquardt (Ceres, central differences) from `start`; returns the final parameters.
 ResponseParams refine(const ResponseData& d, const Layout& L, const ResponseParams& start,
-                      int max_iterations, bool* converged) {
+                      int max_iterations, bool* converged,
+                      BranchChoice choice = BranchChoice::kFollow, double huber_delta = 0.0) {
   std::vector<double> x = pack(start, L);
   auto* cost = new ceres::DynamicNumericDiffCostFunction<OutputError, ceres::CENTRAL>(
-      new OutputError{&d, L, start.f_ref_hz});
+      new OutputError{&d, L, start.f_ref_hz, choice, huber_delta});
   cost->AddParameterBlock(L.size());
   cost->SetNumResiduals(static_cast<int>(2 * d.size()));
   ceres::Problem problem;
@@ -171,6 +181,19 @@ double gridLinear(const ResponseData& d, const std::vector<int>& idx, bool slope
     hi_w = bw * rw * rw;
   }
   return projectLinear(d, idx, bf, bw, slope, f_ref, best);
+}
+
+/// Noise scale of one component from second differences within sweeps (median, so jumps and the
+/// peak's curvature do not count): |z[i+1] - 2 z[i] + z[i-1]| has the scale sqrt(6) sigma per
+/// component, its median 1.1774 sqrt(6) sigma for complex Gaussian noise.
+double noiseFromDifferences(const ResponseData& d) {
+  std::vector<double> a;
+  for (size_t i = 1; i + 1 < d.size(); ++i)
+    if (d.sweep[i - 1] == d.sweep[i] && d.sweep[i + 1] == d.sweep[i])
+      a.push_back(std::abs(d.z[i + 1] - 2.0 * d.z[i] + d.z[i - 1]));
+  if (a.empty()) return 0.0;
+  std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
+  return a[a.size() / 2] / (1.1774 * std::sqrt(6.0));
 }
 
 double lag1Along(const ResponseData& d, const std::vector<cd>& m) {
@@ -345,14 +368,29 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   }
   double best_cost = std::numeric_limits<double>::infinity();
   ResponseParams best = lin;
+  // Each start is refined three ways: on the smooth cost (the stable root nearest the data), then
+  // following the branch in time order from there, and on the branch directly. A point just past a
+  // fold sits on the other branch and its residual has no gradient that moves the fold; points
+  // caught mid-transient near a fold (critical slowing down) are off any stationary model. So the
+  // fit weighs points by Huber beyond 3 noise scales (from second differences along the sweeps).
+  const double delta = 3.0 * noiseFromDifferences(d);
   for (const ResponseParams& s : starts) {
-    bool ok = false;
-    const ResponseParams p = refine(d, L, s, 300, &ok);
-    const double c = costOf(p, d);
-    if (ok && c < best_cost) {
-      best_cost = c;
-      best = p;
-      fit.converged = true;
+    std::vector<ResponseParams> tries = {s};
+    if (L.xi || L.g) {
+      bool ok_smooth = false;
+      const ResponseParams sm =
+          refine(d, L, s, 300, &ok_smooth, BranchChoice::kNearestData, delta);
+      if (ok_smooth) tries.push_back(sm);
+    }
+    for (const ResponseParams& t : tries) {
+      bool ok = false;
+      const ResponseParams p = refine(d, L, t, 300, &ok, BranchChoice::kFollow, delta);
+      const double c = costOf(p, d, delta);
+      if (ok && c < best_cost) {
+        best_cost = c;
+        best = p;
+        fit.converged = true;
+      }
     }
   }
   if (!fit.converged || !(best.width_hz > 0)) throw AnalysisError("the response fit did not converge");
@@ -362,7 +400,11 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   fit.n_points = static_cast<int>(n);
   fit.n_params = L.size();
   fit.n_sweeps = d.sweep.empty() ? 1 : *std::max_element(d.sweep.begin(), d.sweep.end()) + 1;
-  fit.rss = best_cost * zs * zs;
+  fit.rss = costOf(best, d) * zs * zs;
+  int far = 0;
+  for (size_t i = 0; i < n; ++i) far += std::abs(d.z[i] - m[i]) > delta ? 1 : 0;
+  fit.notes.push_back("Huber weights beyond " + std::to_string(delta * zs) + " (3 noise scales): " +
+                      std::to_string(far) + " of " + std::to_string(n) + " points down-weighted");
   fit.sigma = std::sqrt(fit.rss / std::max(1, static_cast<int>(2 * n) - L.size()));
   for (auto& z : m) z = (fit.conjugated ? std::conj(z) : z) * zs;
   fit.model = m;
@@ -416,7 +458,7 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
         if (d.sweep[i] != g) keep.push_back(static_cast<int>(i));
       const ResponseData dg = subset(d, keep);
       bool ok = false;
-      const ResponseParams pg = refine(dg, L, best, 100, &ok);
+      const ResponseParams pg = refine(dg, L, best, 100, &ok, BranchChoice::kFollow, delta);
       if (!ok || !(pg.width_hz > 0)) continue;
       ++used;
       for (const auto& kv : derivedOf(pg, L, zs * zs)) reps[kv.first].push_back(kv.second);
@@ -458,7 +500,8 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
       Eigen::MatrixXd S(L.size(), mlen);  // score of each point (both components)
       for (int i = 0; i < mlen; ++i) {
         const size_t pi = start + i;
-        const cd e = d.z[pi] - mn[pi];
+        cd e = d.z[pi] - mn[pi];
+        if (std::abs(e) > delta) e *= delta / std::abs(e);  // Huber's psi
         S.col(i) = Jp.col(2 * pi) * e.real() + Jp.col(2 * pi + 1) * e.imag();
       }
       for (int lag = 0; lag <= std::min(bw, mlen - 1); ++lag) {

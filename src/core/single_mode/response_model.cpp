@@ -102,7 +102,8 @@ std::vector<double> stableSquaredAmplitudes(const ResponseParams& p, double f, d
 
 std::vector<std::complex<double>> stationaryResponse(const ResponseParams& p,
                                                      const ResponseData& data,
-                                                     std::vector<double>* u_out, int* jumps) {
+                                                     std::vector<double>* u_out, int* jumps,
+                                                     BranchChoice choice) {
   const size_t n = data.size();
   std::vector<std::complex<double>> out(n);
   if (u_out) u_out->assign(n, 0.0);
@@ -112,15 +113,19 @@ std::vector<std::complex<double>> stationaryResponse(const ResponseParams& p,
   double other_prev = std::numeric_limits<double>::quiet_NaN();  // the other stable root, if any
   for (size_t i = 0; i < n; ++i) {
     const double f = data.frequency_hz[i];
-    const std::complex<double> force = data.drive[i] * p.gain * shapeOf(p, data.kind, f);
+    const std::complex<double> force = data.drive[i] * p.gain;
     double u = 0.0;
     double other = std::numeric_limits<double>::quiet_NaN();
     if (!linear) {
       const std::vector<double> roots = stableSquaredAmplitudes(p, f, std::norm(force));
       u = roots.front();
       if (roots.size() == 2) {
-        const bool upper = std::abs(std::sqrt(roots[1]) - std::sqrt(u_prev)) <
-                           std::abs(std::sqrt(roots[0]) - std::sqrt(u_prev));
+        const double ref =
+            choice == BranchChoice::kFollow
+                ? u_prev
+                : std::norm(data.z[i] - data.drive[i] * (p.bg0 + p.bg1 * (f - p.f_ref_hz)));
+        const bool upper = std::abs(std::sqrt(roots[1]) - std::sqrt(ref)) <
+                           std::abs(std::sqrt(roots[0]) - std::sqrt(ref));
         u = roots[upper ? 1 : 0];
         other = roots[upper ? 0 : 1];
       } else if (jumps && std::isfinite(other_prev) &&
@@ -131,8 +136,8 @@ std::vector<std::complex<double>> stationaryResponse(const ResponseParams& p,
     }
     const std::complex<double> D(p.f0_hz * p.f0_hz - f * f + 2.0 * p.f0_hz * p.backbone_hz_per_amp2 * u,
                                  f * (p.width_hz + p.width_growth_hz_per_amp2 * u));
-    const std::complex<double> resonant = force / D;
-    if (linear) u = std::norm(resonant);
+    if (linear) u = std::norm(force / D);
+    const std::complex<double> resonant = force * shapeOf(p, data.kind, f) / D;
     out[i] = data.drive[i] * (p.bg0 + p.bg1 * (f - p.f_ref_hz)) + resonant;
     if (u_out) (*u_out)[i] = u;
     u_prev = u;

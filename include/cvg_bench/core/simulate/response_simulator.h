@@ -29,7 +29,7 @@ struct ResponseSimulatorOptions {
   int sweeps_per_level = 2;            ///< up, down, up, ...
   int points_per_sweep = 60;
   double span_widths = 10.0;           ///< sweep span in widths (widened by the backbone shift)
-  double dwell_time_constants = 4.0;   ///< dwell per point in amplitude time constants 1/(pi w0)
+  double dwell_time_constants = 10.0;  ///< dwell per point in amplitude time constants 1/(pi w0)
   double point_interval_s = 0.0;       ///< written time step (0: the simulated dwell)
   unsigned seed = 1;
 };

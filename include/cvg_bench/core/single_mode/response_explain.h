@@ -16,6 +16,10 @@ struct ResponseExplainOptions {
   ResponseFitOptions fit;
   /// Level of each term's test (two-sided, on the jackknife t of the term in its model).
   double alpha = 0.01;
+  /// ... and its effect at the largest fitted amplitude (|xi| u_max or |g| u_max) must reach this
+  /// fraction of the width: a lineshape distortion of a fraction of a per cent is not an amplitude
+  /// law (with one drive level any lineshape error looks like one).
+  double min_effect_over_width = 0.02;
   /// `unexplained` when the selected model's RSS exceeds this many times the RSS of free linear
   /// Lorentzians per drive level (each level its own f0, width, gain and background).
   double adequacy_threshold = 2.0;
@@ -25,6 +29,7 @@ struct ResponseCandidate {
   ResponseFit fit;
   bool significant = false;                ///< every term of the candidate passes its test
   std::map<std::string, double> p_values;  ///< per term ("xi", "gamma_nl")
+  std::map<std::string, double> effect_over_width;  ///< per term, at the largest amplitude
 };
 
 struct ResponseExplanation {

@@ -1,18 +1,19 @@
 // One driven mode's stationary response (docs/response.md): the one source of the equation that
 // the fit, the generator's truth conversion and the report evaluate.
 //
-//   Z = d (b0 + b1 (f - f_ref)) + d a S(f) / D(u),   u = |d a S(f) / D(u)|^2
+//   Z = d (b0 + b1 (f - f_ref)) + d a S(f) / D(u),   u = |d a / D(u)|^2
 //   D(u) = f0^2 - f^2 + 2 f0 xi u + i f (w0 + g u)
 //
 // f drive frequency [Hz], d drive level (input units), a complex gain, b0, b1 complex background
 // per unit drive (the drive's crosstalk into the detector), S = 1 (displacement) or f / f0
 // (velocity: the i of i omega x is absorbed in a's phase). u is the squared amplitude of the
-// resonant part in the input's x, y unit. f0 and w0 are the zero-amplitude frequency and full
+// displacement in the input's x, y unit (for a velocity response: the velocity reading scaled by
+// f0 / f, which the Duffing terms act on). f0 and w0 are the zero-amplitude frequency and full
 // width at half power [Hz]; xi the backbone (frequency shift per amplitude^2, Duffing: the
 // first-harmonic balance of a cubic stiffness gives f0(u)^2 = f0^2 + 2 f0 xi u exactly) and g the
 // width growth per amplitude^2 (either sign). Q = f0 / w0.
 //
-// u solves the cubic u |D(u)|^2 = |d a S|^2. Where it has three positive roots the middle one is
+// u solves the cubic u |D(u)|^2 = |d a|^2. Where it has three positive roots the middle one is
 // unstable (the slope of u |D|^2 in u is negative there); along a sweep, in time order, the
 // response stays on the stable root nearest the previous point's (that is what makes jumps and
 // up/down hysteresis), and jumps where its branch ends.
@@ -59,11 +60,19 @@ struct ResponseData {
 /// Stable squared amplitudes u >= 0 of u |D(u)|^2 = p, ascending (one or two).
 std::vector<double> stableSquaredAmplitudes(const ResponseParams& p, double f_hz, double power);
 
-/// The model response at every point, following the branch in time order (see above). `u_out`
-/// (optional) receives u per point and `jumps` the number of branch changes.
+/// How the stable root is chosen where there are two.
+enum class BranchChoice {
+  kFollow,        ///< the one nearest the previous point's, in time order (the physics)
+  kNearestData,   ///< the one nearest the data's own |Z - background|^2 (a smooth cost for the
+                  ///< first stage of a fit; no hysteresis of its own)
+};
+
+/// The model response at every point (see above). `u_out` (optional) receives u per point and
+/// `jumps` the number of branch changes.
 std::vector<std::complex<double>> stationaryResponse(const ResponseParams& p,
                                                      const ResponseData& data,
                                                      std::vector<double>* u_out = nullptr,
-                                                     int* jumps = nullptr);
+                                                     int* jumps = nullptr,
+                                                     BranchChoice choice = BranchChoice::kFollow);
 
 }  // namespace cvg_bench
