@@ -323,11 +323,21 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   // Per-drive-level Lorentzians: the nonlinear start and the adequacy reference.
   std::map<double, std::vector<int>> by_level;
   for (size_t i = 0; i < n; ++i) by_level[d.drive[i]].push_back(static_cast<int>(i));
+  std::vector<double> free_abs;  // |residual| of the free per-level fits (the noise scale)
   for (const auto& kv : by_level) {
     if (kv.second.size() < 8) continue;
     ResponseParams p;
+    gridLinear(d, kv.second, L.slope, f_ref, &p);
+    const ResponseData dl = subset(d, kv.second);
+    Layout lin_layout;
+    lin_layout.slope = L.slope;
+    bool ok = false;
+    const ResponseParams pr = refine(dl, lin_layout, p, 200, &ok);
+    if (ok && costOf(pr, dl) < costOf(p, dl)) p = pr;
+    const std::vector<cd> ml = stationaryResponse(p, dl);
+    for (size_t i = 0; i < ml.size(); ++i) free_abs.push_back(std::abs(dl.z[i] - ml[i]));
     ResponseLevelFit lf;
-    lf.rss = gridLinear(d, kv.second, L.slope, f_ref, &p) * zs * zs;
+    lf.rss = costOf(p, dl) * zs * zs;
     lf.drive = kv.first * ds;
     lf.f0_hz = p.f0_hz;
     lf.width_hz = p.width_hz;
@@ -373,7 +383,14 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   // fold sits on the other branch and its residual has no gradient that moves the fold; points
   // caught mid-transient near a fold (critical slowing down) are off any stationary model. So the
   // fit weighs points by Huber beyond 3 noise scales (from second differences along the sweeps).
-  const double delta = 3.0 * noiseFromDifferences(d);
+  // Noise scale: the median |residual| of the free per-level fits (1.1774 sigma for complex
+  // Gaussian noise; correlated noise counts fully), else from second differences.
+  double noise = noiseFromDifferences(d);
+  if (free_abs.size() >= 8) {
+    std::nth_element(free_abs.begin(), free_abs.begin() + free_abs.size() / 2, free_abs.end());
+    noise = free_abs[free_abs.size() / 2] / 1.1774;
+  }
+  const double delta = 3.0 * noise;
   for (const ResponseParams& s : starts) {
     std::vector<ResponseParams> tries = {s};
     if (L.xi || L.g) {

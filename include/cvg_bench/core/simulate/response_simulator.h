@@ -1,6 +1,6 @@
 // A generator of one-mode lock-in sweeps that shares nothing with the fit (docs/response.md): the
 // oscillator x'' + 2 pi (w0 + c2 x^2) x' + (2 pi f0)^2 x + k3 x^3 = F cos(phi) is integrated in time
-// (RK4) through up and down sweeps at several drive levels, the state carried from point to point
+// (RK4, 64 steps a cycle) through up and down sweeps at several drive levels, the state carried from point to point
 // (so jumps and hysteresis happen by themselves), and demodulated like a lock-in over whole drive
 // cycles at the end of each point's dwell.
 #pragma once
@@ -29,7 +29,7 @@ struct ResponseSimulatorOptions {
   int sweeps_per_level = 2;            ///< up, down, up, ...
   int points_per_sweep = 60;
   double span_widths = 10.0;           ///< sweep span in widths (widened by the backbone shift)
-  double dwell_time_constants = 10.0;  ///< dwell per point in amplitude time constants 1/(pi w0)
+  double dwell_time_constants = 7.0;   ///< dwell per point in amplitude time constants 1/(pi w0)
   double point_interval_s = 0.0;       ///< written time step (0: the simulated dwell)
   unsigned seed = 1;
 };
