@@ -88,6 +88,7 @@ nlohmann::json responseExplanationToJson(const ResponseExplanation& x, double co
   j["adequate"] = !x.unexplained;
   j["adequacy"] = {{"rss_selected", num(x.rss_selected)},
                    {"rss_free_levels", num(x.rss_free_levels)},
+                   {"rss_free_level_gains", num(x.rss_free_level_gains)},
                    {"ratio", num(x.adequacy_ratio)},
                    {"threshold", num(x.adequacy_threshold)},
                    {"test", x.adequacy_test}};

@@ -40,7 +40,9 @@ ResponseExplanation explainResponse(const ResponseData& data, const ResponseExpl
                                   {false, true, false}, {true, true, false}};
   for (const ResponseTerms& t : kinds) {
     ResponseCandidate c;
-    c.fit = fitResponse(data, t, o.fit);
+    ResponseFitOptions fo = o.fit;
+    fo.level_gain_check = true;
+    c.fit = fitResponse(data, t, fo);
     bool all = true;
     const double u_max =
         c.fit.u.empty() ? 0.0 : *std::max_element(c.fit.u.begin(), c.fit.u.end());
@@ -76,11 +78,12 @@ ResponseExplanation explainResponse(const ResponseData& data, const ResponseExpl
   x.adequacy_threshold = o.adequacy_threshold;
   x.rss_selected = sel.rss;
   for (const auto& l : sel.levels) x.rss_free_levels += l.rss;
-  if (sel.levels.size() >= 2 && x.rss_free_levels > 0) {
-    x.adequacy_ratio = x.rss_selected / x.rss_free_levels;
+  x.rss_free_level_gains = sel.rss_free_level_gains;
+  if (sel.levels.size() >= 2 && x.rss_free_level_gains > 0) {
+    x.adequacy_ratio = x.rss_selected / x.rss_free_level_gains;
     x.unexplained = x.adequacy_ratio > o.adequacy_threshold;
-    x.adequacy_test = "RSS of the selected model over the RSS of free linear Lorentzians per drive "
-                      "level (" + std::to_string(sel.levels.size()) + " levels)";
+    x.adequacy_test = "RSS of the selected model over its RSS with a free drive factor per level (" +
+                      std::to_string(sel.levels.size()) + " levels)";
   } else {
     x.adequacy_test =
         "one drive level: no check of the amplitude law against free per-level fits";
@@ -89,7 +92,8 @@ ResponseExplanation explainResponse(const ResponseData& data, const ResponseExpl
   std::string v = x.unexplained ? "unexplained: the drive levels differ in a way no amplitude law "
                                   "of the model follows (RSS " +
                                       fmt("%.3g", x.adequacy_ratio) +
-                                      "x that of free per-level fits); best model " + x.selected
+                                      "x that with a free drive factor per level); best model " +
+                                      x.selected
                                 : x.selected == "linear" ? "linear" : x.selected;
   auto d = [&](const char* k) { return sel.derived.at(k).value; };
   v += "; f0 " + fmt("%.8g", d("f0_hz")) + " Hz, width " + fmt("%.4g", d("width_hz")) +

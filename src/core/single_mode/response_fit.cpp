@@ -76,6 +76,61 @@ struct OutputError {
   }
 };
 
+/// The model with a free real factor on the drive of every level but the first (log scale): what
+/// the amplitude law would need to fit the levels' sizes.
+struct ScaledDriveError {
+  const ResponseData* data;
+  Layout layout;
+  double f_ref;
+  std::vector<int> level;  ///< level index per point (0 = the reference level)
+  double huber_delta = 0.0;
+  bool operator()(double const* const* x, double* r) const {
+    const ResponseParams p = unpack(x[0], layout, f_ref);
+    if (!(p.f0_hz > 0.0) || !(p.width_hz > 0.0)) return false;
+    ResponseData d = *data;
+    for (size_t i = 0; i < d.size(); ++i)
+      if (level[i] > 0) d.drive[i] *= std::exp(x[1][level[i] - 1]);
+    const std::vector<cd> m = stationaryResponse(p, d);
+    for (size_t i = 0; i < m.size(); ++i) {
+      cd e = d.z[i] - m[i];
+      const double a = std::abs(e);
+      if (huber_delta > 0.0 && a > huber_delta)
+        e *= std::sqrt(2.0 * huber_delta / a - huber_delta * huber_delta / (a * a));
+      r[2 * i] = e.real();
+      r[2 * i + 1] = e.imag();
+      if (!std::isfinite(r[2 * i]) || !std::isfinite(r[2 * i + 1])) return false;
+    }
+    return true;
+  }
+};
+
+/// RSS of the model refitted with a free drive factor per level (from `start`, factors 1).
+double rssWithFreeDriveScales(const ResponseData& d, const Layout& L, const ResponseParams& start,
+                              const std::vector<int>& level, int n_levels, double huber_delta) {
+  std::vector<double> x = pack(start, L), s(n_levels - 1, 0.0);
+  auto* cost = new ceres::DynamicNumericDiffCostFunction<ScaledDriveError, ceres::CENTRAL>(
+      new ScaledDriveError{&d, L, start.f_ref_hz, level, huber_delta});
+  cost->AddParameterBlock(L.size());
+  cost->AddParameterBlock(n_levels - 1);
+  cost->SetNumResiduals(static_cast<int>(2 * d.size()));
+  ceres::Problem problem;
+  problem.AddResidualBlock(cost, nullptr, x.data(), s.data());
+  ceres::Solver::Options o;
+  o.linear_solver_type = ceres::DENSE_QR;
+  o.max_num_iterations = 200;
+  o.logging_type = ceres::SILENT;
+  ceres::Solver::Summary sum;
+  ceres::Solve(o, &problem, &sum);
+  ResponseData ds = d;
+  for (size_t i = 0; i < ds.size(); ++i)
+    if (level[i] > 0) ds.drive[i] *= std::exp(s[level[i] - 1]);
+  const ResponseParams p = unpack(x.data(), L, start.f_ref_hz);
+  const std::vector<cd> m = stationaryResponse(p, ds);
+  double rss = 0.0;
+  for (size_t i = 0; i < m.size(); ++i) rss += std::norm(d.z[i] - m[i]);
+  return rss;
+}
+
 /// Sum of rho(|Z - model|): squares, or Huber beyond delta (> 0).
 double costOf(const ResponseParams& p, const ResponseData& d, double delta = 0.0) {
   const std::vector<cd> m = stationaryResponse(p, d);
@@ -227,13 +282,17 @@ ResponseData subset(const ResponseData& d, const std::vector<int>& idx) {
   return s;
 }
 
-/// Numerical Jacobian (central differences) of the stacked residuals at x.
+/// Numerical Jacobian (central differences) of the stacked residuals at x. A point whose root
+/// changes branch under the step (a fold crossing it) has no derivative: its rows are left out
+/// (zero), or they would make every column the same spike.
 Eigen::MatrixXd jacobianAt(const ResponseData& d, const Layout& L, double f_ref,
                            const std::vector<double>& x) {
-  const OutputError fn{&d, L, f_ref};
+  const OutputError fn{&d, L, f_ref, BranchChoice::kNearestData};
   const int n = static_cast<int>(2 * d.size());
   Eigen::MatrixXd J(n, L.size());
-  std::vector<double> rp(n), rm(n);
+  std::vector<double> rp(n), rm(n), u0, up, um;
+  std::vector<bool> crossed(d.size(), false);
+  stationaryResponse(unpack(x.data(), L, f_ref), d, &u0, nullptr, BranchChoice::kNearestData);
   for (int j = 0; j < L.size(); ++j) {
     std::vector<double> xp = x, xm = x;
     const double h = 1e-6 * std::max(std::abs(x[j]), j < 2 ? 1e-3 * std::abs(x[0]) : 1e-6);
@@ -243,7 +302,13 @@ Eigen::MatrixXd jacobianAt(const ResponseData& d, const Layout& L, double f_ref,
     const double* pm = xm.data();
     if (!fn(&pp, rp.data()) || !fn(&pm, rm.data())) return Eigen::MatrixXd();
     for (int i = 0; i < n; ++i) J(i, j) = (rp[i] - rm[i]) / (2 * h);
+    stationaryResponse(unpack(xp.data(), L, f_ref), d, &up, nullptr, BranchChoice::kNearestData);
+    stationaryResponse(unpack(xm.data(), L, f_ref), d, &um, nullptr, BranchChoice::kNearestData);
+    for (size_t i = 0; i < d.size(); ++i)
+      if (std::abs(up[i] - um[i]) > 1e-3 * u0[i]) crossed[i] = true;
   }
+  for (size_t i = 0; i < d.size(); ++i)
+    if (crossed[i]) J.middleRows(2 * i, 2).setZero();
   return J;
 }
 
@@ -434,6 +499,17 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   fit.params.width_growth_hz_per_amp2 /= zs * zs;
   const std::map<std::string, double> point = derivedOf(best, L, zs * zs);
   for (const auto& kv : point) fit.derived[kv.first].value = kv.second;
+  // The amplitude law's check: would a free drive factor per level fit much better?
+  if (o.level_gain_check && by_level.size() >= 2) {
+    std::vector<int> level(n, 0);
+    int k = 0;
+    for (const auto& kv : by_level) {
+      for (int i : kv.second) level[i] = k;
+      ++k;
+    }
+    fit.rss_free_level_gains =
+        std::min(fit.rss, rssWithFreeDriveScales(d, L, best, level, k, delta) * zs * zs);
+  }
   if (!o.intervals) return fit;
 
   // What the data cannot determine: near-null directions of the column-scaled Jacobian.

@@ -20,8 +20,10 @@ struct ResponseExplainOptions {
   /// fraction of the width: a lineshape distortion of a fraction of a per cent is not an amplitude
   /// law (with one drive level any lineshape error looks like one).
   double min_effect_over_width = 0.02;
-  /// `unexplained` when the selected model's RSS exceeds this many times the RSS of free linear
-  /// Lorentzians per drive level (each level its own f0, width, gain and background).
+  /// `unexplained` when the selected model's RSS exceeds this many times the RSS of the same model
+  /// with a free drive factor per level: the levels' sizes do not follow the amplitude law (a
+  /// drive that saturates, a gain that changes between levels). f0 drifting between sweeps is not
+  /// an amplitude law and does not count here (it widens the jackknife intervals instead).
   double adequacy_threshold = 2.0;
 };
 
@@ -37,7 +39,8 @@ struct ResponseExplanation {
   std::string selected;
   size_t selected_index = 0;
   bool unexplained = false;
-  double rss_selected = 0.0, rss_free_levels = 0.0, adequacy_ratio = 0.0;
+  double rss_selected = 0.0, rss_free_levels = 0.0, rss_free_level_gains = 0.0;
+  double adequacy_ratio = 0.0;
   double adequacy_threshold = 0.0;
   std::string adequacy_test;
   std::string verdict;

@@ -19,6 +19,8 @@ struct ResponseFitOptions {
   ResponseKind kind = ResponseKind::kDisplacement;
   double confidence = 0.95;
   bool intervals = true;  ///< false: point estimate only (no jackknife refits)
+  /// Also refit with a free drive factor per level (ResponseFit::rss_free_level_gains).
+  bool level_gain_check = false;
   int min_sweeps_for_jackknife = 5;
   /// Relative singular value (column-scaled Jacobian) under which a direction counts as not
   /// determined by the data.
@@ -46,6 +48,9 @@ struct ResponseFit {
   int interval_dof = 0;  ///< degrees of freedom of the intervals' Student t
   double rss = 0.0;    ///< sum of |Z - model|^2 over the points (input units^2)
   double sigma = 0.0;  ///< sqrt(rss / (2 n - k))
+  /// RSS of the same model with a free drive factor per drive level (0 when not computed): how
+  /// much the levels' sizes miss the amplitude law.
+  double rss_free_level_gains = 0.0;
   int n_points = 0, n_sweeps = 0, n_params = 0, n_drive_levels = 0, jumps = 0;
   double residual_lag1 = 0.0;  ///< lag-1 correlation of the residuals along the sweeps
   std::vector<std::complex<double>> model;  ///< the fitted response per point (file's x + iy)
