@@ -20,3 +20,7 @@ if [ -f scripts/validation/validate_real_ringdown.py ]; then
   /usr/bin/python3 scripts/validation/validate_real_ringdown.py --part all --jobs "${VALIDATE_JOBS:-2}" \
     --out build/validate_real --markdown docs/validation_ringdown_real_tables.md
 fi
+if [ -f scripts/validation/validate_response.py ]; then
+  /usr/bin/python3 scripts/validation/validate_response.py --n 40 --jobs "${VALIDATE_JOBS:-2}" \
+    --markdown docs/validation_response_tables.md
+fi

@@ -139,10 +139,12 @@ def one_record(cls, seed, tmp):
         with open(ij) as f:
             y = json.load(f)
         rec["covered"] = {}
+        rec["values"] = {}
         for k, v in truth.items():
             d = y["derived_ci"].get(k)
             if d is not None and k != "width_hz":
                 rec["covered"][k] = bool(d["ci_low"] <= v <= d["ci_high"])
+                rec["values"][k] = [d["value"], d["ci_low"], d["ci_high"], v]
     else:
         rec["identify_error"] = out_i[-300:]
     for p in (path, ej, ij):

@@ -30,7 +30,8 @@ nlohmann::json responseFitToJson(const ResponseFit& fit, double confidence,
     dci[kv.first] = {{"value", num(kv.second.value)},
                      {"std", num(kv.second.std)},
                      {"ci_low", num(kv.second.ci_low)},
-                     {"ci_high", num(kv.second.ci_high)}};
+                     {"ci_high", num(kv.second.ci_high)},
+                     {"dof", kv.second.dof}};
   }
   j["derived_ci"] = dci;
   j["not_determined"] = fit.not_determined;

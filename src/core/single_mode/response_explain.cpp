@@ -22,7 +22,7 @@ double termP(const ResponseFit& f, int term) {
   if (it == f.derived.end() || !(it->second.std > 0)) return 1.0;
   const double t = std::abs(it->second.value / it->second.std);
   if (!std::isfinite(t)) return 1.0;
-  boost::math::students_t dist(std::max(1, f.interval_dof));
+  boost::math::students_t dist(std::max(1, it->second.dof > 0 ? it->second.dof : f.interval_dof));
   return 2.0 * boost::math::cdf(boost::math::complement(dist, t));
 }
 

@@ -76,8 +76,9 @@ struct OutputError {
   }
 };
 
-/// The model with a free real factor on the drive of every level but the first (log scale): what
-/// the amplitude law would need to fit the levels' sizes.
+/// The model with a free real factor on the resonant part's drive of every level but the first
+/// (log scale; the background keeps the drive as written): what the amplitude law would need to
+/// fit the levels' sizes.
 struct ScaledDriveError {
   const ResponseData* data;
   Layout layout;
@@ -88,8 +89,9 @@ struct ScaledDriveError {
     const ResponseParams p = unpack(x[0], layout, f_ref);
     if (!(p.f0_hz > 0.0) || !(p.width_hz > 0.0)) return false;
     ResponseData d = *data;
+    d.resonant_drive_factor.assign(d.size(), 1.0);
     for (size_t i = 0; i < d.size(); ++i)
-      if (level[i] > 0) d.drive[i] *= std::exp(x[1][level[i] - 1]);
+      if (level[i] > 0) d.resonant_drive_factor[i] = std::exp(x[1][level[i] - 1]);
     const std::vector<cd> m = stationaryResponse(p, d);
     for (size_t i = 0; i < m.size(); ++i) {
       cd e = d.z[i] - m[i];
@@ -122,8 +124,9 @@ double rssWithFreeDriveScales(const ResponseData& d, const Layout& L, const Resp
   ceres::Solver::Summary sum;
   ceres::Solve(o, &problem, &sum);
   ResponseData ds = d;
+  ds.resonant_drive_factor.assign(ds.size(), 1.0);
   for (size_t i = 0; i < ds.size(); ++i)
-    if (level[i] > 0) ds.drive[i] *= std::exp(s[level[i] - 1]);
+    if (level[i] > 0) ds.resonant_drive_factor[i] = std::exp(s[level[i] - 1]);
   const ResponseParams p = unpack(x.data(), L, start.f_ref_hz);
   const std::vector<cd> m = stationaryResponse(p, ds);
   double rss = 0.0;
@@ -448,29 +451,71 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   // fold sits on the other branch and its residual has no gradient that moves the fold; points
   // caught mid-transient near a fold (critical slowing down) are off any stationary model. So the
   // fit weighs points by Huber beyond 3 noise scales (from second differences along the sweeps).
-  // Noise scale: the median |residual| of the free per-level fits (1.1774 sigma for complex
-  // Gaussian noise; correlated noise counts fully), else from second differences.
+  // Noise scale: the smaller of the median |residual| of the free per-level fits (1.1774 sigma for
+  // complex Gaussian noise; inflated where a level is not a Lorentzian) and the second
+  // differences' (which correlated noise lowers).
   double noise = noiseFromDifferences(d);
   if (free_abs.size() >= 8) {
     std::nth_element(free_abs.begin(), free_abs.begin() + free_abs.size() / 2, free_abs.end());
-    noise = free_abs[free_abs.size() / 2] / 1.1774;
+    noise = std::min(noise, free_abs[free_abs.size() / 2] / 1.1774);
   }
-  const double delta = 3.0 * noise;
+  // The Huber threshold follows the fit's own misfit: 3 scales of the larger of the noise and
+  // the median residual of the stage's start (a model that misses everywhere is not clipped
+  // everywhere, which would stall Levenberg-Marquardt); candidates are compared on 3 noise scales.
+  auto deltaAt = [&](const ResponseParams& p, BranchChoice c) {
+    const std::vector<cd> m = stationaryResponse(p, d, nullptr, nullptr, c);
+    std::vector<double> a(n);
+    for (size_t i = 0; i < n; ++i) a[i] = std::abs(d.z[i] - m[i]);
+    std::nth_element(a.begin(), a.begin() + n / 2, a.end());
+    return 3.0 * std::max(noise, a[n / 2] / 1.1774);
+  };
+  // A stage refines with the threshold of its start's misfit, then again while the misfit keeps
+  // falling (at most 4 rounds), so a start far off is not clipped everywhere and a close one
+  // ends with the noise's threshold.
+  auto robustRefine = [&](ResponseParams t, BranchChoice c, bool* ok, double* delta_used) {
+    double dl = deltaAt(t, c);
+    *ok = false;
+    for (int round = 0; round < 4; ++round) {
+      bool ok_round = false;
+      const ResponseParams p = refine(d, L, t, 300, &ok_round, c, dl);
+      if (!ok_round) break;
+      *ok = true;
+      t = p;
+      const double next = deltaAt(t, c);
+      *delta_used = dl;
+      if (!(next < 0.8 * dl)) break;
+      dl = next;
+    }
+    return t;
+  };
+  const double delta_compare = 3.0 * noise;
+  double delta = delta_compare;
   for (const ResponseParams& s : starts) {
     std::vector<ResponseParams> tries = {s};
     if (L.xi || L.g) {
       bool ok_smooth = false;
-      const ResponseParams sm =
-          refine(d, L, s, 300, &ok_smooth, BranchChoice::kNearestData, delta);
+      double unused = 0.0;
+      const ResponseParams sm = robustRefine(s, BranchChoice::kNearestData, &ok_smooth, &unused);
       if (ok_smooth) tries.push_back(sm);
     }
-    for (const ResponseParams& t : tries) {
+    if (L.xi || L.g) {  // and the noise's threshold from the start (a fold's point clipped)
+      bool ok_fixed = false;
+      const ResponseParams sf = refine(d, L, s, 300, &ok_fixed, BranchChoice::kNearestData,
+                                       delta_compare);
+      if (ok_fixed) tries.push_back(sf);
+    }
+    for (size_t k = 0; k < tries.size(); ++k) {
       bool ok = false;
-      const ResponseParams p = refine(d, L, t, 300, &ok, BranchChoice::kFollow, delta);
-      const double c = costOf(p, d, delta);
+      double used = delta_compare;
+      const ResponseParams p =
+          k + 1 == tries.size() && (L.xi || L.g)
+              ? refine(d, L, tries[k], 300, &ok, BranchChoice::kFollow, delta_compare)
+              : robustRefine(tries[k], BranchChoice::kFollow, &ok, &used);
+      const double c = costOf(p, d, delta_compare);
       if (ok && c < best_cost) {
         best_cost = c;
         best = p;
+        delta = used;
         fit.converged = true;
       }
     }
@@ -485,7 +530,8 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   fit.rss = costOf(best, d) * zs * zs;
   int far = 0;
   for (size_t i = 0; i < n; ++i) far += std::abs(d.z[i] - m[i]) > delta ? 1 : 0;
-  fit.notes.push_back("Huber weights beyond " + std::to_string(delta * zs) + " (3 noise scales): " +
+  fit.notes.push_back("Huber weights beyond " + std::to_string(delta * zs) +
+                      " (3 scales of the noise or of the median misfit): " +
                       std::to_string(far) + " of " + std::to_string(n) + " points down-weighted");
   fit.sigma = std::sqrt(fit.rss / std::max(1, static_cast<int>(2 * n) - L.size()));
   for (auto& z : m) z = (fit.conjugated ? std::conj(z) : z) * zs;
@@ -508,7 +554,7 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
       ++k;
     }
     fit.rss_free_level_gains =
-        std::min(fit.rss, rssWithFreeDriveScales(d, L, best, level, k, delta) * zs * zs);
+        std::min(fit.rss, rssWithFreeDriveScales(d, L, best, level, k, 0.0) * zs * zs);
   }
   if (!o.intervals) return fit;
 
@@ -556,22 +602,36 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
       ++used;
       for (const auto& kv : derivedOf(pg, L, zs * zs)) reps[kv.first].push_back(kv.second);
     }
+    // Student t with the jackknife's effective degrees of freedom: G - 1 when the sweeps weigh
+    // alike, fewer when a few sweeps carry the estimate (the high drive levels, a drift of f0
+    // between sweeps): 3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations d (= G for
+    // Gaussian d of equal variance), at most G - 1.
     fit.interval_dof = std::max(1, used - 1);
-    const double t = studentQuantile(o.confidence, fit.interval_dof);
+    int min_dof = fit.interval_dof;
     for (auto& kv : reps) {
       const auto& v = kv.second;
       const double mean = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
-      double ss = 0;
-      for (double a : v) ss += (a - mean) * (a - mean);
+      double ss = 0, s4 = 0;
+      for (double a : v) {
+        ss += (a - mean) * (a - mean);
+        s4 += std::pow(a - mean, 4);
+      }
       const double sd = std::sqrt(ss * (v.size() - 1.0) / v.size());
+      const int dof = s4 > 0 ? std::max(1, std::min(fit.interval_dof,
+                                                    static_cast<int>(3.0 * ss * ss / s4)))
+                             : fit.interval_dof;
+      min_dof = std::min(min_dof, dof);
+      const double t = studentQuantile(o.confidence, dof);
       ResponseValue& rv = fit.derived[kv.first];
       rv.std = sd;
+      rv.dof = dof;
       rv.ci_low = rv.value - t * sd;
       rv.ci_high = rv.value + t * sd;
     }
     fit.interval_method = "jackknife over whole sweeps (" + std::to_string(used) + " of " +
-                          std::to_string(G) + " refits), Student t with " +
-                          std::to_string(std::max(1, used - 1)) + " dof";
+                          std::to_string(G) + " refits), Student t with the effective dof " +
+                          std::to_string(min_dof) + ".." + std::to_string(fit.interval_dof) +
+                          " (3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations)";
     if (used < G)
       fit.notes.push_back(std::to_string(G - used) + " jackknife refits did not converge");
   } else {
@@ -609,6 +669,7 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
     const double t = studentQuantile(o.confidence, fit.interval_dof);
     auto setCi = [&](const std::string& key, const Eigen::VectorXd& grad) {
       ResponseValue& rv = fit.derived[key];
+      rv.dof = fit.interval_dof;
       rv.std = std::sqrt(std::max(0.0, grad.dot(cov * grad)));
       rv.ci_low = rv.value - t * rv.std;
       rv.ci_high = rv.value + t * rv.std;

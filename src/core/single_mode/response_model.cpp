@@ -113,7 +113,9 @@ std::vector<std::complex<double>> stationaryResponse(const ResponseParams& p,
   double other_prev = std::numeric_limits<double>::quiet_NaN();  // the other stable root, if any
   for (size_t i = 0; i < n; ++i) {
     const double f = data.frequency_hz[i];
-    const std::complex<double> force = data.drive[i] * p.gain;
+    const double factor =
+        data.resonant_drive_factor.empty() ? 1.0 : data.resonant_drive_factor[i];
+    const std::complex<double> force = factor * data.drive[i] * p.gain;
     double u = 0.0;
     double other = std::numeric_limits<double>::quiet_NaN();
     if (!linear) {

@@ -29,6 +29,7 @@ struct ResponseFitOptions {
 
 struct ResponseValue {
   double value = 0.0, std = 0.0, ci_low = 0.0, ci_high = 0.0;
+  int dof = 0;  ///< degrees of freedom of the interval's Student t
 };
 
 /// A linear Lorentzian fitted to one drive level alone (the initialiser and the adequacy reference).

@@ -53,6 +53,9 @@ struct ResponseData {
   std::vector<double> frequency_hz, drive;
   std::vector<std::complex<double>> z;
   std::vector<int> sweep;  ///< sweep index per point (splitSweeps)
+  /// Optional factor on the drive of the resonant part only (not the background) per point; empty
+  /// = 1. The adequacy check fits one per drive level.
+  std::vector<double> resonant_drive_factor;
   ResponseKind kind = ResponseKind::kDisplacement;
   size_t size() const { return z.size(); }
 };
