@@ -586,57 +586,14 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   }
   fit.not_determined = weak_derived;
 
-  // Intervals: jackknife over whole sweeps, or a within-sweep Bartlett sandwich.
-  std::map<std::string, std::vector<double>> reps;
-  int G = fit.n_sweeps;
-  if (G >= o.min_sweeps_for_jackknife) {
-    int used = 0;
-    for (int g = 0; g < G; ++g) {
-      std::vector<int> keep;
-      for (size_t i = 0; i < n; ++i)
-        if (d.sweep[i] != g) keep.push_back(static_cast<int>(i));
-      const ResponseData dg = subset(d, keep);
-      bool ok = false;
-      const ResponseParams pg = refine(dg, L, best, 100, &ok, BranchChoice::kFollow, delta);
-      if (!ok || !(pg.width_hz > 0)) continue;
-      ++used;
-      for (const auto& kv : derivedOf(pg, L, zs * zs)) reps[kv.first].push_back(kv.second);
-    }
-    // Student t with the jackknife's effective degrees of freedom: G - 1 when the sweeps weigh
-    // alike, fewer when a few sweeps carry the estimate (the high drive levels, a drift of f0
-    // between sweeps): 3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations d (= G for
-    // Gaussian d of equal variance), at most G - 1.
-    fit.interval_dof = std::max(1, used - 1);
-    int min_dof = fit.interval_dof;
-    for (auto& kv : reps) {
-      const auto& v = kv.second;
-      const double mean = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
-      double ss = 0, s4 = 0;
-      for (double a : v) {
-        ss += (a - mean) * (a - mean);
-        s4 += std::pow(a - mean, 4);
-      }
-      const double sd = std::sqrt(ss * (v.size() - 1.0) / v.size());
-      const int dof = s4 > 0 ? std::max(1, std::min(fit.interval_dof,
-                                                    static_cast<int>(3.0 * ss * ss / s4)))
-                             : fit.interval_dof;
-      min_dof = std::min(min_dof, dof);
-      const double t = studentQuantile(o.confidence, dof);
-      ResponseValue& rv = fit.derived[kv.first];
-      rv.std = sd;
-      rv.dof = dof;
-      rv.ci_low = rv.value - t * sd;
-      rv.ci_high = rv.value + t * sd;
-    }
-    fit.interval_method = "jackknife over whole sweeps (" + std::to_string(used) + " of " +
-                          std::to_string(G) + " refits), Student t with the effective dof " +
-                          std::to_string(min_dof) + ".." + std::to_string(fit.interval_dof) +
-                          " (3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations)";
-    if (used < G)
-      fit.notes.push_back(std::to_string(G - used) + " jackknife refits did not converge");
-  } else {
-    // Sandwich: cov = Jp K Jp', Jp the pseudo-inverse of J, K the residual products within a
-    // sweep weighted by a Bartlett kernel over point lags (bandwidth 4 (m/100)^(2/9)).
+  // Intervals. The within-sweep sandwich always (cov = Jp K Jp', Jp the pseudo-inverse of J, K
+  // the residual products within a sweep weighted by a Bartlett kernel over point lags, bandwidth
+  // 4 (m/100)^(2/9)); with 5 or more sweeps also a jackknife over whole sweeps, whose standard
+  // error is used unless the sandwich's is larger (a refit that cannot leave a fold-trap would
+  // make the jackknife's spread too small).
+  const int G = fit.n_sweeps;
+  std::map<std::string, double> sandwich_std;
+  {
     const Eigen::MatrixXd Jp = svd.matrixV() *
                                sv.unaryExpr([&](double s) {
                                    return s > o.rank_tolerance * sv(0) ? 1.0 / s : 0.0;
@@ -665,37 +622,99 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
       start = end;
     }
     cov = scale.cwiseInverse().asDiagonal() * cov * scale.cwiseInverse().asDiagonal();
-    fit.interval_dof = std::max(1, static_cast<int>(2 * n) - L.size());
-    const double t = studentQuantile(o.confidence, fit.interval_dof);
-    auto setCi = [&](const std::string& key, const Eigen::VectorXd& grad) {
-      ResponseValue& rv = fit.derived[key];
-      rv.dof = fit.interval_dof;
-      rv.std = std::sqrt(std::max(0.0, grad.dot(cov * grad)));
-      rv.ci_low = rv.value - t * rv.std;
-      rv.ci_high = rv.value + t * rv.std;
+    auto sd = [&](const Eigen::VectorXd& grad) {
+      return std::sqrt(std::max(0.0, grad.dot(cov * grad)));
     };
     Eigen::VectorXd g0 = Eigen::VectorXd::Zero(L.size()), g1 = g0, gq = g0;
     g0(0) = 1;
     g1(1) = 1;
     gq(0) = 1.0 / best.width_hz;
     gq(1) = -best.f0_hz / (best.width_hz * best.width_hz);
-    setCi("f0_hz", g0);
-    setCi("width_hz", g1);
-    setCi("Q", gq);
+    sandwich_std["f0_hz"] = sd(g0);
+    sandwich_std["width_hz"] = sd(g1);
+    sandwich_std["Q"] = sd(gq);
     int k = 6 + (L.slope ? 2 : 0);
     if (L.xi) {
       Eigen::VectorXd gx = Eigen::VectorXd::Zero(L.size());
       gx(k++) = 1.0 / (zs * zs);
-      setCi("backbone_hz_per_amp2", gx);
+      sandwich_std["backbone_hz_per_amp2"] = sd(gx);
     }
     if (L.g) {
       Eigen::VectorXd gg = Eigen::VectorXd::Zero(L.size());
       gg(k) = 1.0 / (zs * zs);
-      setCi("width_growth_hz_per_amp2", gg);
+      sandwich_std["width_growth_hz_per_amp2"] = sd(gg);
     }
-    fit.interval_method =
-        "sandwich with a Bartlett kernel within each sweep (" + std::to_string(G) +
-        " sweeps: too few for a jackknife over sweeps), Student t";
+  }
+  fit.interval_dof = std::max(1, static_cast<int>(2 * n) - L.size());
+  for (const auto& kv : sandwich_std) {
+    ResponseValue& rv = fit.derived[kv.first];
+    rv.std = kv.second;
+    rv.dof = fit.interval_dof;
+  }
+  fit.interval_method = "sandwich with a Bartlett kernel within each sweep (" + std::to_string(G) +
+                        " sweeps: too few for a jackknife over sweeps), Student t";
+  if (G >= o.min_sweeps_for_jackknife) {
+    std::map<std::string, std::vector<double>> reps;
+    int used = 0;
+    for (int g = 0; g < G; ++g) {
+      std::vector<int> keep;
+      for (size_t i = 0; i < n; ++i)
+        if (d.sweep[i] != g) keep.push_back(static_cast<int>(i));
+      const ResponseData dg = subset(d, keep);
+      // The smooth stage first (continuous in the data), then the branch followed again.
+      bool ok_smooth = false, ok = false;
+      ResponseParams pg = best;
+      if (L.xi || L.g) {
+        const ResponseParams ps =
+            refine(dg, L, best, 100, &ok_smooth, BranchChoice::kNearestData, delta);
+        if (ok_smooth) pg = ps;
+      }
+      pg = refine(dg, L, pg, 100, &ok, BranchChoice::kFollow, delta);
+      if (!ok || !(pg.width_hz > 0)) continue;
+      ++used;
+      for (const auto& kv : derivedOf(pg, L, zs * zs)) reps[kv.first].push_back(kv.second);
+    }
+    // Student t with the jackknife's effective degrees of freedom: G - 1 when the sweeps weigh
+    // alike, fewer when a few sweeps carry the estimate (the high drive levels, a drift of f0
+    // between sweeps): 3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations d (= G for
+    // Gaussian d of equal variance), at most G - 1.
+    fit.interval_dof = std::max(1, used - 1);
+    int min_dof = fit.interval_dof, floored = 0;
+    for (auto& kv : reps) {
+      const auto& v = kv.second;
+      const double mean = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+      double ss = 0, s4 = 0;
+      for (double a : v) {
+        ss += (a - mean) * (a - mean);
+        s4 += std::pow(a - mean, 4);
+      }
+      double sd = std::sqrt(ss * (v.size() - 1.0) / v.size());
+      const int dof = s4 > 0 ? std::max(1, std::min(fit.interval_dof,
+                                                    static_cast<int>(3.0 * ss * ss / s4)))
+                             : fit.interval_dof;
+      min_dof = std::min(min_dof, dof);
+      if (sandwich_std.count(kv.first) && sandwich_std[kv.first] > sd) {
+        sd = sandwich_std[kv.first];
+        ++floored;
+      }
+      ResponseValue& rv = fit.derived[kv.first];
+      rv.std = sd;
+      rv.dof = dof;
+    }
+    fit.interval_method = "jackknife over whole sweeps (" + std::to_string(used) + " of " +
+                          std::to_string(G) + " refits), Student t with the effective dof " +
+                          std::to_string(min_dof) + ".." + std::to_string(fit.interval_dof) +
+                          " (3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations); " +
+                          std::to_string(floored) +
+                          " standard errors raised to the within-sweep sandwich's";
+    if (used < G)
+      fit.notes.push_back(std::to_string(G - used) + " jackknife refits did not converge");
+  }
+  for (auto& kv : fit.derived) {
+    ResponseValue& rv = kv.second;
+    const double t = studentQuantile(o.confidence, std::max(1, rv.dof));
+    rv.ci_low = rv.value - t * rv.std;
+    rv.ci_high = rv.value + t * rv.std;
   }
   return fit;
 }
