@@ -10,6 +10,7 @@ No case may end by a signal or print a sanitizer report. Base records come from 
 simulate` (mems_ring preset, fixed seeds) so the expected results are known.
 """
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -495,6 +496,69 @@ class BadInputSuite(unittest.TestCase):
         self.check("fuzz: preset with a map as a key (regression)",
                    ["simulate", "--config", yml, "--mode", "free_decay", "--out",
                     self.out(".csv")], "bad", names=(yml, "not text"))
+
+    # ---- one-mode frequency response (--mode response) -----------------------------------------
+    def test_response_mode(self):
+        clean = os.path.join(self.work, "response.csv")
+        rc, _, err = run_tool(["simulate", "--mode", "response", "--q", "50", "--levels", "2",
+                               "--points", "20", "--seed", "7", "--out", clean])
+        self.assertEqual(rc, 0, err)
+        with open(clean) as f:
+            lines = f.read().splitlines()
+        body = [l for l in lines if not l.startswith("#")]
+        ident = ["identify", "--mode", "response"]
+
+        def variant(row, field, value):
+            rows = list(body)
+            cells = rows[row].split(",")
+            cells[field] = value
+            rows[row] = ",".join(cells)
+            return self.write("\n".join(rows) + "\n")
+
+        self.check("response: clean", ident[:1] + [clean] + ident[1:], "ok")
+        for v in ["nan", "inf", "-", "1e400"]:
+            p = variant(5, 2, v)
+            self.check("response: x = " + v, ["identify", p, "--mode", "response"], "bad",
+                       names=(p + ":6", "field 3 (x)"))
+        p = variant(5, 4, "0")
+        self.check("response: drive 0", ["identify", p, "--mode", "response"], "bad",
+                   names=(p + ":6", "drive"))
+        p = variant(5, 1, "-3")
+        self.check("response: negative frequency", ["identify", p, "--mode", "response"], "bad",
+                   names=(p + ":6", "frequency_hz"))
+        p = variant(5, 0, "0")
+        self.check("response: time back", ["identify", p, "--mode", "response"], "bad",
+                   names=(p + ":6", "time must increase"))
+        p = self.write(body[0] + "\n")
+        self.check("response: header only", ["identify", p, "--mode", "response"], "bad",
+                   names=("at least 8",))
+        p = self.write("")
+        self.check("response: empty", ["identify", p, "--mode", "response"], "bad")
+        p = self.write("\n".join(body[1:]) + "\n")
+        self.check("response: headerless with --columns", ["identify", p, "--mode", "response",
+                   "--columns", "t=1,frequency_hz=2,x=3,y=4,drive=5"], "ok")
+        for cols, name in (("t=1,x=3,y=4", "frequency_hz"), ("frequency_hz=0,x=3,y=4", "from 1"),
+                           ("frequency_hz=2,x=3,y=4,z=5", "unknown key"),
+                           ("frequency_hz=2,frequency_hz=3,x=3,y=4", "twice"),
+                           ("frequency_hz=9,x=3,y=4", "no field 9")):
+            self.check("response: --columns " + cols, ["identify", p, "--mode", "response",
+                       "--columns", cols], "bad", names=(name,))
+        for opt, val, name in (("--response", "speed", "response"), ("--model", "xi_diff", "two modes"),
+                               ("--model", "mu", "two modes"), ("--confidence", "2", "confidence")):
+            self.check("response: %s %s" % (opt, val), ["identify", clean, "--mode", "response",
+                       opt, val], "bad", names=(name,))
+        noise = self.write("t,frequency_hz,x,y,drive\n" + "".join(
+            "%d,%g,%g,%g,1\n" % (i, 100 + 0.1 * i, math.sin(7.3 * i), math.cos(3.1 * i ** 1.5))
+            for i in range(60)))
+        self.check("response: no resonance (noise only)", ["identify", noise, "--mode",
+                   "response"], "refuse", names=("no resonance",))
+        for args, name in ((["--levels", "0"], "levels"), (["--points", "3"], "points"),
+                           (["--q", "-1"], "q"), (["--effect", "kappa=1"], "kappa"),
+                           (["--correlation", "1"], "correlation"),
+                           (["--effect", "gamma_nl=-100"], "diverged")):
+            self.check("response simulate " + " ".join(args), ["simulate", "--mode", "response",
+                       "--out", self.out(".csv")] + args, "bad" if name != "diverged" else "refuse",
+                       names=(name,))
 
     # ---- options --------------------------------------------------------------------------------
     def test_absurd_options(self):

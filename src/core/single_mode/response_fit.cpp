@@ -716,6 +716,13 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
     rv.ci_low = rv.value - t * rv.std;
     rv.ci_high = rv.value + t * rv.std;
   }
+  // No resonance: a width whose interval reaches zero is not a mode's (noise, or a mode outside
+  // the swept band); nothing of it is reported as a number.
+  const ResponseValue& w = fit.derived.at("width_hz");
+  if (!(w.ci_low > 0.0))
+    throw AnalysisError("no resonance determined by these data: the width's interval [" +
+                        std::to_string(w.ci_low) + ", " + std::to_string(w.ci_high) +
+                        "] Hz reaches zero (noise only, or the mode outside the swept band)");
   return fit;
 }
 
