@@ -537,6 +537,7 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   for (auto& z : m) z = (fit.conjugated ? std::conj(z) : z) * zs;
   fit.model = m;
   for (auto& u : fit.u) u *= zs * zs;
+  for (auto& l : fit.levels) l.peak_u *= zs * zs;  // normalised until the starts were made
   fit.params = best;
   fit.params.gain *= zs / ds;
   fit.params.bg0 *= zs / ds;
