@@ -22,6 +22,13 @@ class _Recorder(unittest.TextTestResult):
         super().addError(test, err)
         self.records.append((test.id(), self._exc_info_to_string(err, test)))
 
+    def addSubTest(self, test, subtest, err):
+        # A failing subTest fails its test (unittest then calls neither addSuccess nor
+        # addFailure for the test itself): record it, or the summary would count nothing.
+        super().addSubTest(test, subtest, err)
+        if err is not None:
+            self.records.append((subtest.id(), self._exc_info_to_string(err, subtest)))
+
 
 def main(directory, out):
     suite = unittest.defaultTestLoader.discover(directory, pattern="test_*.py", top_level_dir=directory)
