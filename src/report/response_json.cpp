@@ -8,9 +8,13 @@ namespace cvg_bench {
 namespace report {
 namespace {
 
-nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+nlohmann::json num(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
 
-nlohmann::json complexJson(std::complex<double> c) { return {{"re", num(c.real())}, {"im", num(c.imag())}}; }
+nlohmann::json complexJson(std::complex<double> c) {
+  return {{"re", num(c.real())}, {"im", num(c.imag())}};
+}
 
 }  // namespace
 
@@ -69,12 +73,9 @@ nlohmann::json responseExplanationToJson(const ResponseExplanation& x, double co
   j["mode"] = "response";
   nlohmann::json cands = nlohmann::json::array();
   for (const auto& c : x.candidates) {
-    nlohmann::json cj = {{"model", c.fit.terms.name()},
-                         {"rss", num(c.fit.rss)},
-                         {"jumps", c.fit.jumps},
-                         {"significant", c.significant},
-                         {"p_values", c.p_values},
-                         {"effect_over_width", c.effect_over_width}};
+    nlohmann::json cj = {{"model", c.fit.terms.name()}, {"rss", num(c.fit.rss)},
+                         {"jumps", c.fit.jumps},        {"significant", c.significant},
+                         {"p_values", c.p_values},      {"effect_over_width", c.effect_over_width}};
     nlohmann::json dci = nlohmann::json::object();
     for (const auto& kv : c.fit.derived)
       dci[kv.first] = {{"value", num(kv.second.value)},

@@ -29,11 +29,14 @@ const char* kIdentifyHelp =
     "         [--columns t=N,frequency_hz=N,x=N,y=N,drive=N] [--response displacement|velocity]\n"
     "         [--confidence P] [--json FILE]\n"
     "One mode's complex response Z = x + iy against drive frequency (lock-in, network analyser),\n"
-    "all drive levels and up/down sweeps of the file fitted at once by output error, following the\n"
+    "all drive levels and up/down sweeps of the file fitted at once by output error, following "
+    "the\n"
     "branch along each sweep in time order (jumps, hysteresis). INPUT: CSV or whitespace columns,\n"
     "'#'/'%' comments; named columns t, frequency_hz, x, y, drive (per point), direction; a\n"
-    "headerless file through --columns (1-based; without it 5 columns are t,frequency_hz,x,y,drive).\n"
-    "Prints f0, width (FWHM) and Q, and with xi the backbone (Hz per amplitude^2, amplitude in the\n"
+    "headerless file through --columns (1-based; without it 5 columns are "
+    "t,frequency_hz,x,y,drive).\n"
+    "Prints f0, width (FWHM) and Q, and with xi the backbone (Hz per amplitude^2, amplitude in "
+    "the\n"
     "x, y unit), with gamma_nl the width growth (Hz per amplitude^2, either sign). Intervals: a\n"
     "jackknife over whole sweeps (5 or more sweeps), else a within-sweep sandwich.\n"
     "--response velocity: the lock-in sees the velocity (e.g. a wire's induced voltage).\n"
@@ -67,18 +70,19 @@ ResponseRecord readInput(const CliArgs& args, std::vector<std::string>& notes) {
 
 ResponseKind kindOf(const CliArgs& args, std::vector<std::string>& notes) {
   if (args.has("response")) return parseResponseKind(args.get("response"));
-  notes.push_back("--response not given: displacement assumed (velocity for a wire's or a coil's "
-                  "induced voltage)");
+  notes.push_back(
+      "--response not given: displacement assumed (velocity for a wire's or a coil's "
+      "induced voltage)");
   return ResponseKind::kDisplacement;
 }
 
 void printFit(const ResponseFit& f, std::ostream& os) {
-  os << "mode response, model " << f.terms.name() << ", " << f.n_points << " points, "
-     << f.n_sweeps << " sweeps, " << f.n_drive_levels << " drive levels, response "
-     << responseKindName(f.kind) << "\n";
+  os << "mode response, model " << f.terms.name() << ", " << f.n_points << " points, " << f.n_sweeps
+     << " sweeps, " << f.n_drive_levels << " drive levels, response " << responseKindName(f.kind)
+     << "\n";
   char buf[200];
-  for (const char* k : {"f0_hz", "width_hz", "Q", "backbone_hz_per_amp2",
-                        "width_growth_hz_per_amp2"}) {
+  for (const char* k :
+       {"f0_hz", "width_hz", "Q", "backbone_hz_per_amp2", "width_growth_hz_per_amp2"}) {
     const auto it = f.derived.find(k);
     if (it == f.derived.end()) continue;
     if (std::find(f.not_determined.begin(), f.not_determined.end(), k) != f.not_determined.end()) {
@@ -152,9 +156,8 @@ int runResponseIdentify(const std::vector<std::string>& argv) {
 }
 
 int runResponseExplain(const std::vector<std::string>& argv) {
-  const CliArgs args(
-      argv, {"mode", "columns", "response", "confidence", "json", "report", "alpha"},
-      {"no-figures"});
+  const CliArgs args(argv, {"mode", "columns", "response", "confidence", "json", "report", "alpha"},
+                     {"no-figures"});
   if (args.help()) {
     std::cout << kExplainHelp;
     return 0;

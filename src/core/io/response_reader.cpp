@@ -31,8 +31,10 @@ std::string lowerTrimmed(const std::string& s) {
 std::vector<std::string> splitRow(const std::string& line) {
   std::vector<std::string> out;
   char sep = 0;
-  if (line.find(',') != std::string::npos) sep = ',';
-  else if (line.find(';') != std::string::npos) sep = ';';
+  if (line.find(',') != std::string::npos)
+    sep = ',';
+  else if (line.find(';') != std::string::npos)
+    sep = ';';
   if (sep != 0) {
     std::string cur;
     for (char c : line) {
@@ -172,8 +174,7 @@ ResponseRecord readResponseText(const std::string& text, const std::string& sour
           rec.notes.push_back(
               "no header and no --columns: columns read as frequency_hz, x, y (one drive level)");
         } else {
-          throw InputError(where + std::to_string(line_no) + ": " +
-                           std::to_string(fields.size()) +
+          throw InputError(where + std::to_string(line_no) + ": " + std::to_string(fields.size()) +
                            " columns and no header: give --columns t=N,frequency_hz=N,x=N,y=N,"
                            "drive=N");
         }

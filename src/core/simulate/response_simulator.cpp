@@ -16,7 +16,8 @@ ResponseRecord simulateResponse(const ResponseSimulatorOptions& o) {
   if (o.levels < 1 || o.levels > 50) throw InputError("levels: 1 to 50");
   if (o.points_per_sweep < 8 || o.points_per_sweep > 5000)
     throw InputError("points per sweep: 8 to 5000");
-  if (o.sweeps_per_level < 1 || o.sweeps_per_level > 20) throw InputError("sweeps per level: 1 to 20");
+  if (o.sweeps_per_level < 1 || o.sweeps_per_level > 20)
+    throw InputError("sweeps per level: 1 to 20");
   if (!(o.correlation >= 0 && o.correlation < 1)) throw InputError("correlation: [0, 1)");
   const double two_pi = 2.0 * M_PI;
   const double w0 = o.f0_hz / o.q;
@@ -54,7 +55,8 @@ ResponseRecord simulateResponse(const ResponseSimulatorOptions& o) {
   const double innovation = o.noise * std::sqrt(1.0 - o.correlation * o.correlation);
   for (int level = 0; level < o.levels; ++level) {
     const double frac =
-        o.levels == 1 ? 1.0 : std::pow(8.0, -static_cast<double>(o.levels - 1 - level) / (o.levels - 1));
+        o.levels == 1 ? 1.0
+                      : std::pow(8.0, -static_cast<double>(o.levels - 1 - level) / (o.levels - 1));
     const double force_nominal = frac * o.max_amplitude * two_pi * two_pi * o.f0_hz * w0;
     double force = force_nominal;
     if (o.saturation_amplitude > 0) {
@@ -66,12 +68,13 @@ ResponseRecord simulateResponse(const ResponseSimulatorOptions& o) {
       const double om0 = two_pi * f0;
       const bool up = s % 2 == 0;
       for (int k = 0; k < o.points_per_sweep; ++k) {
-        const double a = static_cast<double>(up ? k : o.points_per_sweep - 1 - k) /
-                         (o.points_per_sweep - 1);
+        const double a =
+            static_cast<double>(up ? k : o.points_per_sweep - 1 - k) / (o.points_per_sweep - 1);
         const double f = centre - half + 2.0 * half * a;
         const double dwell = o.dwell_time_constants * tau * (k == 0 ? 3.0 : 1.0);
         const int cycles = std::max(4, static_cast<int>(std::ceil(dwell * f)));
-        const int avg_cycles = std::max(2, static_cast<int>(std::floor(std::min(tau, dwell / 2) * f)));
+        const int avg_cycles =
+            std::max(2, static_cast<int>(std::floor(std::min(tau, dwell / 2) * f)));
         const int steps_per_cycle = 64;  // RK4's numerical damping: Q_num ~ 2e7
         const double dt = 1.0 / (f * steps_per_cycle);
         auto accel = [&](double xx, double vv, double ph) {
@@ -84,8 +87,10 @@ ResponseRecord simulateResponse(const ResponseSimulatorOptions& o) {
         const double dphi = two_pi * f * dt;
         for (int i = 0; i < n_steps; ++i) {
           const double k1x = v, k1v = accel(x, v, phi);
-          const double k2x = v + 0.5 * dt * k1v, k2v = accel(x + 0.5 * dt * k1x, k2x, phi + 0.5 * dphi);
-          const double k3x = v + 0.5 * dt * k2v, k3v = accel(x + 0.5 * dt * k2x, k3x, phi + 0.5 * dphi);
+          const double k2x = v + 0.5 * dt * k1v,
+                       k2v = accel(x + 0.5 * dt * k1x, k2x, phi + 0.5 * dphi);
+          const double k3x = v + 0.5 * dt * k2v,
+                       k3v = accel(x + 0.5 * dt * k2x, k3x, phi + 0.5 * dphi);
           const double k4x = v + dt * k3v, k4v = accel(x + dt * k3x, k4x, phi + dphi);
           x += dt / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x);
           v += dt / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
@@ -97,14 +102,15 @@ ResponseRecord simulateResponse(const ResponseSimulatorOptions& o) {
           }
         }
         if (!std::isfinite(x) || !std::isfinite(v))
-          throw AnalysisError("the simulated oscillator diverged (a negative width at the "
-                              "amplitudes reached: w0 + g A^2 < 0)");
+          throw AnalysisError(
+              "the simulated oscillator diverged (a negative width at the "
+              "amplitudes reached: w0 + g A^2 < 0)");
         t += n_steps * dt;
         std::complex<double> z = acc * (2.0 / (avg_cycles * steps_per_cycle));
         z += force_nominal / (o.max_amplitude * two_pi * two_pi * o.f0_hz * w0) *
              (o.background + o.background_slope_per_hz * (f - o.f0_hz));
-        noise_state = o.correlation * noise_state +
-                      innovation * std::complex<double>(gauss(rng), gauss(rng));
+        noise_state =
+            o.correlation * noise_state + innovation * std::complex<double>(gauss(rng), gauss(rng));
         z += noise_state;
         if (o.conjugate) z = std::conj(z);
         rec.t_s.push_back(o.point_interval_s > 0 ? rec.size() * o.point_interval_s : t);

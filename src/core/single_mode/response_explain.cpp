@@ -36,16 +36,15 @@ std::string fmt(const char* f, double v) {
 
 ResponseExplanation explainResponse(const ResponseData& data, const ResponseExplainOptions& o) {
   ResponseExplanation x;
-  const ResponseTerms kinds[4] = {{false, false, false}, {true, false, false},
-                                  {false, true, false}, {true, true, false}};
+  const ResponseTerms kinds[4] = {
+      {false, false, false}, {true, false, false}, {false, true, false}, {true, true, false}};
   for (const ResponseTerms& t : kinds) {
     ResponseCandidate c;
     ResponseFitOptions fo = o.fit;
     fo.level_gain_check = true;
     c.fit = fitResponse(data, t, fo);
     bool all = true;
-    const double u_max =
-        c.fit.u.empty() ? 0.0 : *std::max_element(c.fit.u.begin(), c.fit.u.end());
+    const double u_max = c.fit.u.empty() ? 0.0 : *std::max_element(c.fit.u.begin(), c.fit.u.end());
     const double w = c.fit.derived.at("width_hz").value;
     for (int term = 0; term < 2; ++term) {
       if (!(term == 0 ? t.backbone : t.width_growth)) continue;
@@ -82,22 +81,23 @@ ResponseExplanation explainResponse(const ResponseData& data, const ResponseExpl
   if (sel.levels.size() >= 2 && x.rss_free_level_gains > 0) {
     x.adequacy_ratio = x.rss_selected / x.rss_free_level_gains;
     x.unexplained = x.adequacy_ratio > o.adequacy_threshold;
-    x.adequacy_test = "RSS of the selected model over its RSS with a free drive factor per level (" +
-                      std::to_string(sel.levels.size()) + " levels)";
-  } else {
     x.adequacy_test =
-        "one drive level: no check of the amplitude law against free per-level fits";
+        "RSS of the selected model over its RSS with a free drive factor per level (" +
+        std::to_string(sel.levels.size()) + " levels)";
+  } else {
+    x.adequacy_test = "one drive level: no check of the amplitude law against free per-level fits";
   }
   // The verdict in words.
-  std::string v = x.unexplained ? "unexplained: the drive levels differ in a way no amplitude law "
-                                  "of the model follows (RSS " +
-                                      fmt("%.3g", x.adequacy_ratio) +
-                                      "x that with a free drive factor per level); best model " +
-                                      x.selected
-                                : x.selected == "linear" ? "linear" : x.selected;
+  std::string v = x.unexplained
+                      ? "unexplained: the drive levels differ in a way no amplitude law "
+                        "of the model follows (RSS " +
+                            fmt("%.3g", x.adequacy_ratio) +
+                            "x that with a free drive factor per level); best model " + x.selected
+                  : x.selected == "linear" ? "linear"
+                                           : x.selected;
   auto d = [&](const char* k) { return sel.derived.at(k).value; };
-  v += "; f0 " + fmt("%.8g", d("f0_hz")) + " Hz, width " + fmt("%.4g", d("width_hz")) +
-       " Hz, Q " + fmt("%.4g", d("Q"));
+  v += "; f0 " + fmt("%.8g", d("f0_hz")) + " Hz, width " + fmt("%.4g", d("width_hz")) + " Hz, Q " +
+       fmt("%.4g", d("Q"));
   if (sel.terms.backbone)
     v += std::string("; ") + (d("backbone_hz_per_amp2") < 0 ? "softening" : "hardening") +
          " backbone " + fmt("%.4g", d("backbone_hz_per_amp2")) + " Hz/amp^2";

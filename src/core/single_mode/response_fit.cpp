@@ -42,8 +42,8 @@ ResponseParams unpack(const double* x, const Layout& L, double f_ref) {
 }
 
 std::vector<double> pack(const ResponseParams& p, const Layout& L) {
-  std::vector<double> x = {p.f0_hz,        p.width_hz,     p.gain.real(),
-                           p.gain.imag(),  p.bg0.real(),   p.bg0.imag()};
+  std::vector<double> x = {p.f0_hz,       p.width_hz,   p.gain.real(),
+                           p.gain.imag(), p.bg0.real(), p.bg0.imag()};
   if (L.slope) {
     x.push_back(p.bg1.real());
     x.push_back(p.bg1.imag());
@@ -259,7 +259,8 @@ double lag1Along(const ResponseData& d, const std::vector<cd>& m) {
   for (size_t i = 0; i < d.size(); ++i) {
     const cd e = d.z[i] - m[i];
     den += std::norm(e);
-    if (i > 0 && d.sweep[i] == d.sweep[i - 1]) num += std::real(e * std::conj(d.z[i - 1] - m[i - 1]));
+    if (i > 0 && d.sweep[i] == d.sweep[i - 1])
+      num += std::real(e * std::conj(d.z[i - 1] - m[i - 1]));
   }
   return den > 0 ? num / den : 0.0;
 }
@@ -315,8 +316,7 @@ Eigen::MatrixXd jacobianAt(const ResponseData& d, const Layout& L, double f_ref,
   return J;
 }
 
-const char* const kParamNames[] = {"f0_hz", "width_hz", "gain", "gain", "background",
-                                   "background"};
+const char* const kParamNames[] = {"f0_hz", "width_hz", "gain", "gain", "background", "background"};
 
 }  // namespace
 
@@ -366,7 +366,8 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
     lin = lin_conj;
     fit.notes.push_back(
         "phase convention: the response's phase falls through the resonance with y as written "
-        "taken as -Im (lock-in y = -quadrature); the fit used x - iy, results are independent of it");
+        "taken as -Im (lock-in y = -quadrature); the fit used x - iy, results are independent of "
+        "it");
   } else {
     fit.notes.push_back(
         "phase convention: x + iy with the phase of a displacement-like response falling by pi "
@@ -500,8 +501,8 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
     }
     if (L.xi || L.g) {  // and the noise's threshold from the start (a fold's point clipped)
       bool ok_fixed = false;
-      const ResponseParams sf = refine(d, L, s, 300, &ok_fixed, BranchChoice::kNearestData,
-                                       delta_compare);
+      const ResponseParams sf =
+          refine(d, L, s, 300, &ok_fixed, BranchChoice::kNearestData, delta_compare);
       if (ok_fixed) tries.push_back(sf);
     }
     for (size_t k = 0; k < tries.size(); ++k) {
@@ -520,7 +521,8 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
       }
     }
   }
-  if (!fit.converged || !(best.width_hz > 0)) throw AnalysisError("the response fit did not converge");
+  if (!fit.converged || !(best.width_hz > 0))
+    throw AnalysisError("the response fit did not converge");
   // Statistics in the input's units.
   std::vector<cd> m = stationaryResponse(best, d, &fit.u, &fit.jumps);
   fit.residual_lag1 = lag1Along(d, m);
@@ -531,8 +533,8 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   int far = 0;
   for (size_t i = 0; i < n; ++i) far += std::abs(d.z[i] - m[i]) > delta ? 1 : 0;
   fit.notes.push_back("Huber weights beyond " + std::to_string(delta * zs) +
-                      " (3 scales of the noise or of the median misfit): " +
-                      std::to_string(far) + " of " + std::to_string(n) + " points down-weighted");
+                      " (3 scales of the noise or of the median misfit): " + std::to_string(far) +
+                      " of " + std::to_string(n) + " points down-weighted");
   fit.sigma = std::sqrt(fit.rss / std::max(1, static_cast<int>(2 * n) - L.size()));
   for (auto& z : m) z = (fit.conjugated ? std::conj(z) : z) * zs;
   fit.model = m;
@@ -562,7 +564,8 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   // What the data cannot determine: near-null directions of the column-scaled Jacobian.
   const std::vector<double> x = pack(best, L);
   const Eigen::MatrixXd J = jacobianAt(d, L, f_ref, x);
-  if (J.size() == 0) throw AnalysisError("the fitted response cannot be evaluated near the optimum");
+  if (J.size() == 0)
+    throw AnalysisError("the fitted response cannot be evaluated near the optimum");
   Eigen::VectorXd scale = J.colwise().norm();
   for (int j = 0; j < scale.size(); ++j) scale(j) = scale(j) > 0 ? scale(j) : 1.0;
   const Eigen::MatrixXd Js = J * scale.cwiseInverse().asDiagonal();
@@ -690,9 +693,9 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
         s4 += std::pow(a - mean, 4);
       }
       double sd = std::sqrt(ss * (v.size() - 1.0) / v.size());
-      const int dof = s4 > 0 ? std::max(1, std::min(fit.interval_dof,
-                                                    static_cast<int>(3.0 * ss * ss / s4)))
-                             : fit.interval_dof;
+      const int dof =
+          s4 > 0 ? std::max(1, std::min(fit.interval_dof, static_cast<int>(3.0 * ss * ss / s4)))
+                 : fit.interval_dof;
       min_dof = std::min(min_dof, dof);
       if (sandwich_std.count(kv.first) && sandwich_std[kv.first] > sd) {
         sd = sandwich_std[kv.first];

@@ -31,9 +31,9 @@ Cubic cubicAt(const ResponseParams& p, double f) {
 /// The root of h(u) = power in [lo, hi] where h - power changes sign (h monotonic there).
 double rootIn(const Cubic& h, double power, double lo, double hi) {
   std::uintmax_t iters = 60;
-  const auto r = boost::math::tools::toms748_solve([&](double u) { return h(u) - power; }, lo, hi,
-                                                   boost::math::tools::eps_tolerance<double>(44),
-                                                   iters);
+  const auto r =
+      boost::math::tools::toms748_solve([&](double u) { return h(u) - power; }, lo, hi,
+                                        boost::math::tools::eps_tolerance<double>(44), iters);
   return 0.5 * (r.first + r.second);
 }
 
@@ -85,8 +85,8 @@ std::vector<double> stableSquaredAmplitudes(const ResponseParams& p, double f, d
     u2 = std::max(ra, rb);
   }
   // Upper bracket: h(hi) > power.
-  double hi = std::max({u2, 0.0, std::cbrt(power / std::max(h.A, tiny)),
-                        h.C > 0 ? power / h.C : 0.0, 1e-300});
+  double hi = std::max(
+      {u2, 0.0, std::cbrt(power / std::max(h.A, tiny)), h.C > 0 ? power / h.C : 0.0, 1e-300});
   for (int k = 0; k < 400 && h(hi) <= power; ++k) hi *= 2.0;
   std::vector<double> roots;
   if (u2 <= 0.0) {  // h rises on u >= 0
@@ -113,8 +113,7 @@ std::vector<std::complex<double>> stationaryResponse(const ResponseParams& p,
   double other_prev = std::numeric_limits<double>::quiet_NaN();  // the other stable root, if any
   for (size_t i = 0; i < n; ++i) {
     const double f = data.frequency_hz[i];
-    const double factor =
-        data.resonant_drive_factor.empty() ? 1.0 : data.resonant_drive_factor[i];
+    const double factor = data.resonant_drive_factor.empty() ? 1.0 : data.resonant_drive_factor[i];
     const std::complex<double> force = factor * data.drive[i] * p.gain;
     double u = 0.0;
     double other = std::numeric_limits<double>::quiet_NaN();
@@ -136,8 +135,9 @@ std::vector<std::complex<double>> stationaryResponse(const ResponseParams& p,
         ++*jumps;  // the branch ended: the response went over to the other one
       }
     }
-    const std::complex<double> D(p.f0_hz * p.f0_hz - f * f + 2.0 * p.f0_hz * p.backbone_hz_per_amp2 * u,
-                                 f * (p.width_hz + p.width_growth_hz_per_amp2 * u));
+    const std::complex<double> D(
+        p.f0_hz * p.f0_hz - f * f + 2.0 * p.f0_hz * p.backbone_hz_per_amp2 * u,
+        f * (p.width_hz + p.width_growth_hz_per_amp2 * u));
     if (linear) u = std::norm(force / D);
     const std::complex<double> resonant = force * shapeOf(p, data.kind, f) / D;
     out[i] = data.drive[i] * (p.bg0 + p.bg1 * (f - p.f_ref_hz)) + resonant;

@@ -104,7 +104,8 @@ TEST(ResponseReader, BadInputNamesLineAndField) {
   EXPECT_NE(errorOf(backwards).find("time must increase"), std::string::npos);
   std::string zero_drive = text;
   zero_drive.replace(zero_drive.find("1e-08"), 5, "0.000");
-  EXPECT_NE(errorOf(zero_drive).find("drive must be > 0"), std::string::npos) << errorOf(zero_drive);
+  EXPECT_NE(errorOf(zero_drive).find("drive must be > 0"), std::string::npos)
+      << errorOf(zero_drive);
   EXPECT_NE(errorOf("# only comments\n").find("at least 8"), std::string::npos);
 }
 

@@ -29,8 +29,8 @@ struct ResponseExplainOptions {
 
 struct ResponseCandidate {
   ResponseFit fit;
-  bool significant = false;                ///< every term of the candidate passes its test
-  std::map<std::string, double> p_values;  ///< per term ("xi", "gamma_nl")
+  bool significant = false;                         ///< every term of the candidate passes its test
+  std::map<std::string, double> p_values;           ///< per term ("xi", "gamma_nl")
   std::map<std::string, double> effect_over_width;  ///< per term, at the largest amplitude
 };
 

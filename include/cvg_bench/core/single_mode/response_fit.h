@@ -1,7 +1,7 @@
 // Output-error fit of one mode's stationary response over every drive level and both sweep
 // directions at once (docs/response.md): Ceres on the branch-following model of response_model.h,
-// started from per-drive-level Lorentzians (variable projection over f0 and width); intervals from a
-// jackknife over whole sweeps (residuals along a sweep are correlated) or, with fewer than 5
+// started from per-drive-level Lorentzians (variable projection over f0 and width); intervals from
+// a jackknife over whole sweeps (residuals along a sweep are correlated) or, with fewer than 5
 // sweeps, a sandwich with a Bartlett kernel within each sweep.
 #pragma once
 
@@ -32,7 +32,8 @@ struct ResponseValue {
   int dof = 0;  ///< degrees of freedom of the interval's Student t
 };
 
-/// A linear Lorentzian fitted to one drive level alone (the initialiser and the adequacy reference).
+/// A linear Lorentzian fitted to one drive level alone (the initialiser and the adequacy
+/// reference).
 struct ResponseLevelFit {
   double drive = 0.0, f0_hz = 0.0, width_hz = 0.0, peak_u = 0.0, rss = 0.0;
   int n_points = 0;
@@ -41,19 +42,20 @@ struct ResponseLevelFit {
 struct ResponseFit {
   ResponseTerms terms;
   ResponseKind kind = ResponseKind::kDisplacement;
-  ResponseParams params;  ///< in the input's units
+  ResponseParams params;    ///< in the input's units
   bool conjugated = false;  ///< the lock-in's y runs the other way: the fit used x - iy
-  std::map<std::string, ResponseValue> derived;  ///< f0_hz, width_hz, Q, backbone..., width_growth...
-  std::vector<std::string> not_determined;       ///< what these data cannot determine
+  std::map<std::string, ResponseValue>
+      derived;                              ///< f0_hz, width_hz, Q, backbone..., width_growth...
+  std::vector<std::string> not_determined;  ///< what these data cannot determine
   std::string interval_method;
   int interval_dof = 0;  ///< degrees of freedom of the intervals' Student t
-  double rss = 0.0;    ///< sum of |Z - model|^2 over the points (input units^2)
-  double sigma = 0.0;  ///< sqrt(rss / (2 n - k))
+  double rss = 0.0;      ///< sum of |Z - model|^2 over the points (input units^2)
+  double sigma = 0.0;    ///< sqrt(rss / (2 n - k))
   /// RSS of the same model with a free drive factor per drive level (0 when not computed): how
   /// much the levels' sizes miss the amplitude law.
   double rss_free_level_gains = 0.0;
   int n_points = 0, n_sweeps = 0, n_params = 0, n_drive_levels = 0, jumps = 0;
-  double residual_lag1 = 0.0;  ///< lag-1 correlation of the residuals along the sweeps
+  double residual_lag1 = 0.0;               ///< lag-1 correlation of the residuals along the sweeps
   std::vector<std::complex<double>> model;  ///< the fitted response per point (file's x + iy)
   std::vector<double> u;                    ///< squared resonant amplitude per point
   std::vector<ResponseLevelFit> levels;

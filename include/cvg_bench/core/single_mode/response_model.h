@@ -27,7 +27,6 @@
 
 namespace cvg_bench {
 
-
 /// Which terms a one-mode model has: `xi` (backbone), `gamma_nl` (width growth), background slope.
 struct ResponseTerms {
   bool backbone = false;
@@ -65,9 +64,9 @@ std::vector<double> stableSquaredAmplitudes(const ResponseParams& p, double f_hz
 
 /// How the stable root is chosen where there are two.
 enum class BranchChoice {
-  kFollow,        ///< the one nearest the previous point's, in time order (the physics)
-  kNearestData,   ///< the one nearest the data's own |Z - background|^2 (a smooth cost for the
-                  ///< first stage of a fit; no hysteresis of its own)
+  kFollow,       ///< the one nearest the previous point's, in time order (the physics)
+  kNearestData,  ///< the one nearest the data's own |Z - background|^2 (a smooth cost for the
+                 ///< first stage of a fit; no hysteresis of its own)
 };
 
 /// The model response at every point (see above). `u_out` (optional) receives u per point and
