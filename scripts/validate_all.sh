@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `make validate`: the independent validation harness (scripts/validate_independent.py: explain
 # verdicts and identify intervals on records the fit does not share), then, where present, the
-# ring-down validation. Extra arguments go to the harness (e.g. --quick, --kinds fd_slow,sweep,
+# ring-down validation, the real ring-downs and the one-mode response harness (30 records a class,
+# ~22 min on 2 cores: the whole of `make validate` now takes about an hour). Extra arguments go to the harness (e.g. --quick, --kinds fd_slow,sweep,
 # --compare build/validate/before.json). Clean trajectories are cached in build/validate/work; the
 # run's results are kept in build/validate/last.json (the input of a later --compare).
 # --thin 3 (every clean record, a seed-chosen third of the others: 590 runs, ~10 min) keeps the
@@ -21,6 +22,6 @@ if [ -f scripts/validation/validate_real_ringdown.py ]; then
     --out build/validate_real --markdown docs/validation_ringdown_real_tables.md
 fi
 if [ -f scripts/validation/validate_response.py ]; then
-  /usr/bin/python3 scripts/validation/validate_response.py --n 40 --jobs "${VALIDATE_JOBS:-2}" \
+  /usr/bin/python3 scripts/validation/validate_response.py --n 30 --jobs "${VALIDATE_JOBS:-2}" \
     --markdown docs/validation_response_tables.md
 fi
