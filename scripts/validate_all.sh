@@ -2,7 +2,8 @@
 # `make validate`: the independent validation harness (scripts/validate_independent.py: explain
 # verdicts and identify intervals on records the fit does not share), then, where present, the
 # ring-down validation, the real ring-downs and the one-mode response harness (30 records a class,
-# ~22 min on 2 cores: the whole of `make validate` now takes about an hour). Extra arguments go to the harness (e.g. --quick, --kinds fd_slow,sweep,
+# ~22 min on 2 cores: the whole of `make validate` now takes about an hour). Extra arguments go
+# to the harness (e.g. --quick, --kinds fd_slow,sweep,
 # --compare build/validate/before.json). Clean trajectories are cached in build/validate/work; the
 # run's results are kept in build/validate/last.json (the input of a later --compare).
 # --thin 3 (every clean record, a seed-chosen third of the others: 590 runs, ~10 min) keeps the
