@@ -50,6 +50,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from real_ringdown_common import wilson  # noqa: E402
+
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 TOOL = os.path.join(ROOT, "bin", "cvg_ident")
 DATA = os.path.abspath(os.path.join(ROOT, "..", "shared", "data", "sweeps_vibrating_wire"))
@@ -58,16 +61,6 @@ COVERAGE_RANGE = (0.90, 0.98)
 DETECTION_MIN = 0.95
 FALSE_TERMS_MAX = 0.05
 REPORTING_BASE = 52410000
-
-
-def wilson(k, n, z=1.96):
-    if n == 0:
-        return (float("nan"), float("nan"))
-    p = k / n
-    d = 1 + z * z / n
-    c = (p + z * z / (2 * n)) / d
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
-    return (max(0.0, c - h), min(1.0, c + h))
 
 
 def draw(cls, seed):

@@ -2,8 +2,6 @@
 // (docs/interfaces.md, "One-mode frequency response"; docs/response.md). Reader:
 // core/io/response_record.h; model, fit and selection: core/single_mode/response_*.h; generator:
 // core/simulate/response_simulator.h.
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -19,6 +17,7 @@
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_bench/report/response_json.h"
 #include "cvg_ident_commands.h"
+#include "report_directory.h"
 
 namespace cvg_bench {
 namespace tools {
@@ -98,22 +97,11 @@ void printFit(const ResponseFit& f, std::ostream& os) {
   for (const auto& n : f.notes) os << "note: " << n << "\n";
 }
 
-void makeDirectory(const std::string& dir) {
-  std::string partial;
-  for (size_t i = 0; i <= dir.size(); ++i) {
-    if ((i == dir.size() || dir[i] == '/') && !partial.empty()) ::mkdir(partial.c_str(), 0755);
-    if (i < dir.size()) partial += dir[i];
-  }
-  struct stat st;
-  if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
-    throw InputError("--report: cannot create directory '" + dir + "'");
-}
-
 /// Data of the report (read by scripts/response_report.py): the points and every candidate's
 /// response.
 void writeReport(const std::string& dir, const nlohmann::json& j, const ResponseRecord& r,
                  const ResponseData& d, const ResponseExplanation& x) {
-  makeDirectory(dir);
+  makeReportDirectory(dir);
   report::writeJsonFile(j, dir + "/explain.json");
   std::ofstream out(dir + "/response_points.csv");
   out << std::setprecision(12) << "t,frequency_hz,drive,sweep,x,y";

@@ -2,8 +2,6 @@
 // (interfaces.md, "Single-channel ring-downs"). Reader: core/io/ringdown_record.h; segmentation and
 // fit: core/estimate/ringdown_*.h; causes: core/diagnose/ringdown_causes.h; generator:
 // core/simulate/ringdown_simulator.h.
-#include <sys/stat.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +20,7 @@
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_bench/report/ringdown_json.h"
 #include "cvg_ident_commands.h"
+#include "report_directory.h"
 
 namespace cvg_bench {
 namespace tools {
@@ -152,21 +151,10 @@ RingdownFitOptions fitOptions(const CliArgs& args) {
   return o;
 }
 
-void makeDirectory(const std::string& dir) {
-  std::string partial;
-  for (size_t i = 0; i <= dir.size(); ++i) {
-    if ((i == dir.size() || dir[i] == '/') && !partial.empty()) ::mkdir(partial.c_str(), 0755);
-    if (i < dir.size()) partial += dir[i];
-  }
-  struct stat st;
-  if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
-    throw InputError("--report: cannot create directory '" + dir + "'");
-}
-
 /// Data files of the ring-down report (read by scripts/ringdown_report.py).
 void writeReportFiles(const std::string& dir, const nlohmann::json& j, const RingdownEnvelope& env,
                       const RingdownExplanation& x) {
-  makeDirectory(dir);
+  makeReportDirectory(dir);
   report::writeJsonFile(j, dir + "/explain.json");
   std::ofstream e(dir + "/ringdown_envelope.csv");
   e << std::setprecision(10) << "t,level_db,in_span,dropout\n";

@@ -53,6 +53,22 @@ std::vector<double> pack(const ResponseParams& p, const Layout& L) {
   return x;
 }
 
+/// Re and Im of Z - model per point into r, scaled by Huber's sqrt(rho) / |e| beyond delta (> 0);
+/// false on a non-finite residual.
+bool stackResiduals(const std::vector<cd>& z, const std::vector<cd>& m, double huber_delta,
+                    double* r) {
+  for (size_t i = 0; i < m.size(); ++i) {
+    cd e = z[i] - m[i];
+    const double a = std::abs(e);
+    if (huber_delta > 0.0 && a > huber_delta)
+      e *= std::sqrt(2.0 * huber_delta / a - huber_delta * huber_delta / (a * a));
+    r[2 * i] = e.real();
+    r[2 * i + 1] = e.imag();
+    if (!std::isfinite(r[2 * i]) || !std::isfinite(r[2 * i + 1])) return false;
+  }
+  return true;
+}
+
 struct OutputError {
   const ResponseData* data;
   Layout layout;
@@ -63,16 +79,7 @@ struct OutputError {
     const ResponseParams p = unpack(x[0], layout, f_ref);
     if (!(p.f0_hz > 0.0) || !(p.width_hz > 0.0)) return false;
     const std::vector<cd> m = stationaryResponse(p, *data, nullptr, nullptr, choice);
-    for (size_t i = 0; i < m.size(); ++i) {
-      cd e = data->z[i] - m[i];
-      const double a = std::abs(e);
-      if (huber_delta > 0.0 && a > huber_delta)
-        e *= std::sqrt(2.0 * huber_delta / a - huber_delta * huber_delta / (a * a));
-      r[2 * i] = e.real();
-      r[2 * i + 1] = e.imag();
-      if (!std::isfinite(r[2 * i]) || !std::isfinite(r[2 * i + 1])) return false;
-    }
-    return true;
+    return stackResiduals(data->z, m, huber_delta, r);
   }
 };
 
@@ -93,16 +100,7 @@ struct ScaledDriveError {
     for (size_t i = 0; i < d.size(); ++i)
       if (level[i] > 0) d.resonant_drive_factor[i] = std::exp(x[1][level[i] - 1]);
     const std::vector<cd> m = stationaryResponse(p, d);
-    for (size_t i = 0; i < m.size(); ++i) {
-      cd e = d.z[i] - m[i];
-      const double a = std::abs(e);
-      if (huber_delta > 0.0 && a > huber_delta)
-        e *= std::sqrt(2.0 * huber_delta / a - huber_delta * huber_delta / (a * a));
-      r[2 * i] = e.real();
-      r[2 * i + 1] = e.imag();
-      if (!std::isfinite(r[2 * i]) || !std::isfinite(r[2 * i + 1])) return false;
-    }
-    return true;
+    return stackResiduals(d.z, m, huber_delta, r);
   }
 };
 
