@@ -23,6 +23,8 @@ int runRingdownSimulate(const std::vector<std::string>& args);
 int runResponseIdentify(const std::vector<std::string>& args);
 int runResponseExplain(const std::vector<std::string>& args);
 int runResponseSimulate(const std::vector<std::string>& args);
+// Many records through identify/explain, resumable and sharded (cmd_batch.cpp, docs/fleet.md).
+int runBatch(const std::vector<std::string>& args);
 
 }  // namespace tools
 }  // namespace cvg_bench

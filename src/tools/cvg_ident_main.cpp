@@ -22,6 +22,8 @@ const char* kUsage =
     "  simulate  --mode ringdown --out FILE ...                      (see --mode ringdown --help)\n"
     "  identify|explain INPUT --mode response [--columns ...] ...   one mode's frequency response\n"
     "  simulate  --mode response --out FILE ...                      (see --mode response --help)\n"
+    "  batch     INPUT...|MANIFEST.csv --mode MODE [--explain] [--jobs N] [--shard I/N] --out DIR\n"
+    "            (and batch --merge DIR --out DIR)                  many records, a fleet table\n"
     "exit status: 0 success, 1 analysis failed, 2 bad usage or input\n";
 
 }  // namespace
@@ -32,11 +34,8 @@ int main(int argc, char** argv) {
   // codes).
   FLAGS_minloglevel = google::GLOG_FATAL;
   const std::map<std::string, int (*)(const std::vector<std::string>&)> commands = {
-      {"simulate", runSimulate},
-      {"demod", runDemod},
-      {"identify", runIdentify},
-      {"drift", runDrift},
-      {"explain", runExplain}};
+      {"simulate", runSimulate}, {"demod", runDemod},     {"identify", runIdentify},
+      {"drift", runDrift},       {"explain", runExplain}, {"batch", runBatch}};
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     std::cout << kUsage;
     return argc < 2 ? 2 : 0;
