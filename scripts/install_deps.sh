@@ -17,6 +17,7 @@ PACKAGES=(
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   rviz xvfb x11-apps
   clang-14 libclang-rt-14-dev
+  parallel
 )
 
 missing=()
