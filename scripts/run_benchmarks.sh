@@ -190,3 +190,8 @@ if kept is not None:
 open(md_path, "w").write("\n".join(lines))
 print("run_benchmarks: wrote", md_path)
 PY
+# Many records: `cvg_ident batch` against a shell loop of single calls (docs/benchmarks_batch.md).
+echo "run_benchmarks: scripts/bench_batch.py"
+/usr/bin/python3 scripts/bench_batch.py --records "${CVG_BENCH_BATCH_RECORDS:-40}" > "$out/batch.txt" || {
+  echo "run_benchmarks: bench_batch.py failed" >&2
+}

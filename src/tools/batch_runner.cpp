@@ -208,7 +208,8 @@ BatchRunSummary runBatchJobs(const std::vector<BatchJob>& jobs, const BatchRunOp
     }
     int st = 0;
     rusage ru{};
-    const pid_t pid = wait4(-1, &st, WNOHANG, &ru);
+    // Without a timeout the batch sleeps in wait4 until a record ends; with one it polls (2 ms).
+    const pid_t pid = wait4(-1, &st, options.timeout_s > 0 ? WNOHANG : 0, &ru);
     if (pid <= 0) {
       if (options.timeout_s > 0)
         for (auto& r : running)
@@ -218,7 +219,7 @@ BatchRunSummary runBatchJobs(const std::vector<BatchJob>& jobs, const BatchRunOp
             kill(r.first, SIGKILL);
             r.second.timed_out = true;
           }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
       continue;
     }
     const auto it = running.find(pid);

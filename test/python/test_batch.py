@@ -211,6 +211,37 @@ class Batch(unittest.TestCase):
                 self.assertIn(needle, p.stderr)
 
 
+class BatchExplainTwoMode(unittest.TestCase):
+    def test_explain_rows_carry_the_selected_model_and_reports(self):
+        tmp = tempfile.mkdtemp(prefix="cvg_batch_explain_")
+        try:
+            files = []
+            for seed, effect in ((5, []), (6, ["--effect", "xi=0.05"])):
+                p = os.path.join(tmp, "fd%d.csv" % seed)
+                run(["simulate", "--preset", "quartz_cylinder", "--mode", "free_decay", "--seed", str(seed),
+                     "--out", p] + effect, check=0)
+                files.append(p)
+            o = os.path.join(tmp, "o")
+            run(["batch"] + files + ["--mode", "free_decay", "--explain", "--reports", "--no-figures",
+                                     "--jobs", "2", "--out", o], check=0)
+            rows = read_csv(os.path.join(o, "fleet.csv"))
+            self.assertEqual([r["record"] for r in rows], ["fd5", "fd6"])
+            for r in rows:
+                with open(os.path.join(o, "records", r["json"])) as f:
+                    x = json.load(f)
+                self.assertEqual(r["verdict"], "unexplained" if x["unexplained"] else "explained")
+                self.assertEqual(r["model"], "+".join(["linear"] + x["selected"]))
+                self.assertAlmostEqual(float(r["Q"]), x["final"]["derived_ci"]["Q"]["value"],
+                                       delta=1e-8 * float(r["Q"]))
+                self.assertAlmostEqual(float(r["frequency_hz"]), x["final"]["omega"] / (2 * 3.141592653589793),
+                                       delta=1e-6)
+                self.assertTrue(os.path.isdir(os.path.join(o, "records", r["record"] + "_report")))
+            # The hidden cubic stiffness of fd6 is found (as by a single explain call).
+            self.assertIn("xi", rows[1]["model"].split("+"))
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
 @unittest.skipUnless(os.path.isdir(QPIT), "real ring-downs absent (../shared/data/ringdowns_qpit_dev)")
 class BatchOnRealRingdowns(unittest.TestCase):
     def test_a_repeat_group_equals_single_calls(self):
