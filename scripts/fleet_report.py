@@ -10,7 +10,8 @@ DIR/fleet_repeat_scatter.png (when groups have repeats) and DIR/fleet.md.
 
 Groups: records with equal values of the grouping columns (default: the manifest's sample column,
 the first of sample_id, sample, resonator, serial, with mode_id when present). Per group: n, median
-Q, relative scatter (sd / mean) and the RMS of z = (Q_i - Q_j) / sqrt(se_i^2 + se_j^2) over the
+Q, relative scatter (sd / mean), the between-run excess sqrt(max(0, sd^2 - mean se^2)) / mean, and the
+RMS of z = (Q_i - Q_j) / sqrt(se_i^2 + se_j^2) over the
 pairs: about 1 when the intervals account for what varies between repeats, above 1 when repeats
 differ by more than each record's interval says (run-to-run variation).
 Outliers: within a group of 3 or more, a record whose Q differs from the median of the others by
@@ -87,6 +88,10 @@ def groups_of(records, cols):
                     se = math.hypot(a.get("std") or 0.0, b.get("std") or 0.0)
                     if se > 0:
                         zs.append((a["value"] - b["value"]) / se)
+            # Between-run excess: the part of the repeats' variance their own intervals do not
+            # explain, sqrt(max(0, s^2 - mean se^2)), relative to the mean (0 when they cover it).
+            se2 = [(q.get("std") or 0.0) ** 2 for _, q in with_q]
+            g["Q_between_run_excess"] = math.sqrt(max(0.0, sd * sd - sum(se2) / len(se2))) / mean if mean else None
             g["pairs"] = len(zs)
             g["z_rms"] = math.sqrt(sum(z * z for z in zs) / len(zs)) if zs else None
         out.append(g)
@@ -219,10 +224,12 @@ def main(argv):
         json.dump({"group_by": cols, "groups": groups, "outliers": odd}, f, indent=1)
     with open(os.path.join(d, "fleet_groups.csv"), "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(cols + ["n", "n_with_q", "Q_median", "Q_mean", "Q_relative_scatter", "pairs", "z_rms", "records"])
+        w.writerow(cols + ["n", "n_with_q", "Q_median", "Q_mean", "Q_relative_scatter", "Q_between_run_excess",
+                           "pairs", "z_rms", "records"])
         for g in groups:
             w.writerow([g["group"][c] for c in cols] + [g["n"], g["n_with_q"], fmt(g.get("Q_median"), "%.8g"),
                         fmt(g.get("Q_mean"), "%.8g"), fmt(g.get("Q_relative_scatter"), "%.5g"),
+                        fmt(g.get("Q_between_run_excess"), "%.5g"),
                         g.get("pairs", ""), fmt(g.get("z_rms"), "%.4g"), " ".join(g["records"])])
     made = plots(d, records, groups)
 
@@ -255,18 +262,23 @@ def main(argv):
         lines += ["![%s](%s)" % (p, p), ""]
     if groups:
         lines += ["## Groups by %s" % ", ".join(cols), "",
-                  "| group | n | median Q | repeat scatter | RMS z of pairs |", "|---|---|---|---|---|"]
+                  "| group | n | median Q | repeat scatter | between-run excess | RMS z of pairs |",
+                  "|---|---|---|---|---|---|"]
         for g in groups:
             if g["n"] < 2:
                 continue
-            lines.append("| %s | %d | %s | %s | %s |" % (
+            lines.append("| %s | %d | %s | %s | %s | %s |" % (
                 " ".join(str(v) for v in g["group"].values()), g["n"], fmt(g.get("Q_median")),
                 fmt(100 * g["Q_relative_scatter"], "%.1f %%") if g.get("Q_relative_scatter") is not None else "",
+                fmt(100 * g["Q_between_run_excess"], "%.1f %%") if g.get("Q_between_run_excess") is not None else "",
                 fmt(g.get("z_rms"), "%.2f")))
         rep = [g for g in groups if g.get("Q_relative_scatter") is not None]
         if rep:
-            lines += ["", "Median repeat scatter %.1f %% over %d groups with repeats." %
-                      (100 * median([g["Q_relative_scatter"] for g in rep]), len(rep))]
+            lines += ["", "Median repeat scatter %.1f %% over %d groups with repeats; median between-run excess "
+                      "%.1f %% (the scatter the records' own intervals do not explain: add it in quadrature to a "
+                      "record's interval when the question is what a repeat would give)." %
+                      (100 * median([g["Q_relative_scatter"] for g in rep]), len(rep),
+                       100 * median([g["Q_between_run_excess"] for g in rep if g.get("Q_between_run_excess") is not None]))]
         lines.append("")
     if odd:
         lines += ["## Outliers", ""] + ["- %s: %s" % (o["record"], o["why"]) for o in odd] + [""]

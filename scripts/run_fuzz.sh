@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # make fuzz: libFuzzer (clang-14, -fsanitize=fuzzer,address,undefined) on the CSV record reader,
-# the ring-down CSV reader, the one-mode response reader, the rosbag reader, the `drift --params` JSON and the preset YAML, each
+# the ring-down CSV reader, the one-mode response reader, the files batch reads back, the rosbag reader, the `drift --params` JSON and the preset YAML, each
 # for FUZZ_SECONDS (default 60 s) from the seed corpus in test/fuzz/corpus/<target>/ (new inputs go
 # to build/fuzz/corpus, crashes to build/fuzz/crashes). A crash fails the run; add the input to the
 # bad-input suite.
@@ -28,7 +28,8 @@ cmake -S "$root" -B "$b" -DCVG_CORE_ONLY=ON -DCVG_FUZZ=ON -DCMAKE_BUILD_TYPE=Rel
   -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_CXX_FLAGS_RELEASE="-DNDEBUG" -DCMAKE_CXX_FLAGS="$san" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" "${extra[@]}" \
   > "$root/build/fuzz_configure.log" 2>&1 || { tail -n 30 "$root/build/fuzz_configure.log"; exit 1; }
-targets=(fuzz_csv_reader fuzz_params_json fuzz_preset_yaml fuzz_ringdown_reader fuzz_response_reader)
+targets=(fuzz_csv_reader fuzz_params_json fuzz_preset_yaml fuzz_ringdown_reader fuzz_response_reader
+  fuzz_batch_files)
 [ ${#extra[@]} -gt 0 ] && targets+=(fuzz_bag_reader)
 cmake --build "$b" --target "${targets[@]}" -j "$jobs" > "$root/build/fuzz_build.log" 2>&1 \
   || { grep -E "error" "$root/build/fuzz_build.log" | head -n 30; exit 1; }
@@ -37,7 +38,8 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 failed=0
 for t in "${targets[@]}"; do
   name=${t#fuzz_}
-  case $name in csv_reader) c=csv;; params_json) c=params;; preset_yaml) c=preset;; ringdown_reader) c=ringdown;; response_reader) c=response;; bag_reader) c=bag;; esac
+  case $name in csv_reader) c=csv;; params_json) c=params;; preset_yaml) c=preset;; ringdown_reader) c=ringdown;; response_reader) c=response;; bag_reader) c=bag;;
+    batch_files) c=batch;; esac
   mkdir -p "$b/corpus/$c" "$b/crashes/$c"
   # Past findings (test/fuzz/regressions/<kind>/, also cases of the bad-input suite) are rerun first.
   regress=()

@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "cvg_bench/core/model/errors.h"
+#include "json_fields.h"
 
 namespace cvg_bench {
 namespace tools {
@@ -164,17 +165,26 @@ nlohmann::json readBatchStatus(const std::string& path) {
   std::ifstream in(path);
   if (!in) return nlohmann::json::object();
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.value("complete", false))
-    return nlohmann::json::object();
-  return j;
+  // Only a complete status of the expected shape counts; anything else (truncated, hand-edited,
+  // another version) is as if absent: the record runs again, a merge leaves it out.
+  const std::string name = stringField(j, "record");
+  const long long index = intField(j, "index", -1), count = intField(j, "record_count", -1);
+  const bool ok = !j.is_discarded() && boolField(j, "complete", false) && !name.empty() &&
+                  name.find('/') == std::string::npos && name[0] != '.' && index >= 0 &&
+                  count > index && intField(j, "exit_status", -1) >= 0 &&
+                  j.contains("input_hash") && j["input_hash"].is_string() &&
+                  j.contains("settings_hash") && j["settings_hash"].is_string() &&
+                  j.contains("json") && j["json"].is_string() &&
+                  (stringField(j, "json").empty() || stringField(j, "json") == name + ".json");
+  return ok ? j : nlohmann::json::object();
 }
 
 bool batchJobDone(const BatchJob& job) {
   const nlohmann::json s = readBatchStatus(job.status_path);
-  if (s.empty() || s.value("input_hash", "") != job.input_hash ||
-      s.value("settings_hash", "") != job.settings_hash)
+  if (s.empty() || stringField(s, "input_hash") != job.input_hash ||
+      stringField(s, "settings_hash") != job.settings_hash)
     return false;
-  const int rc = s.value("exit_status", -1);
+  const long long rc = intField(s, "exit_status", -1);
   if (rc == 1 || rc == 2) return true;
   if (rc != 0) return false;
   std::ifstream in(job.json_path);
@@ -227,7 +237,7 @@ BatchRunSummary runBatchJobs(const std::vector<BatchJob>& jobs, const BatchRunOp
     const BatchJob& job = jobs[it->second.job];
     const double secs = std::chrono::duration<double>(Clock::now() - it->second.start).count();
     finishJob(job, st, ru, secs, it->second.timed_out, options.timeout_s);
-    const int rc = readBatchStatus(job.status_path).value("exit_status", 1);
+    const long long rc = intField(readBatchStatus(job.status_path), "exit_status", 1);
     ++sum.ran;
     if (rc == 1 || rc == 2) ++sum.failed;
     if (rc > 2) ++sum.crashed;

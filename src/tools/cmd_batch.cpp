@@ -13,6 +13,7 @@
 #include "cvg_bench/core/model/package_resources.h"
 #include "cvg_ident_commands.h"
 #include "fleet_table.h"
+#include "json_fields.h"
 
 namespace cvg_bench {
 namespace tools {
@@ -153,17 +154,17 @@ int merge(const BatchArgs& a, const std::string& out) {
     if (!fs::is_directory(fs::path(d) / "records"))
       throw InputError("--merge " + d + ": no records/ folder (not a batch output folder)");
     for (auto& e : readFleetEntries(d)) {
-      const size_t n = e.status.value("record_count", size_t(0));
+      const size_t n = static_cast<size_t>(intField(e.status, "record_count", 0));
       if (record_count != 0 && n != record_count)
-        throw InputError("--merge " + d + ": record " + e.status.value("record", "") +
+        throw InputError("--merge " + d + ": record " + stringField(e.status, "record") +
                          " is from a list of " + std::to_string(n) + " records, others from " +
                          std::to_string(record_count) + " (different batches)");
       record_count = n;
-      const size_t i = e.status.value("index", size_t(0));
+      const size_t i = static_cast<size_t>(intField(e.status, "index", 0));
       if (by_index.count(i)) continue;  // the same record in two folders: the first is kept
       if (!fs::equivalent(d, out)) {
         const fs::path src = fs::path(d) / "records", dst = fs::path(out) / "records";
-        const std::string name = e.status.value("record", "");
+        const std::string name = stringField(e.status, "record");
         for (const auto& f : {name + ".json", name + ".log", name + ".status.json"})
           if (fs::exists(src / f))
             fs::copy_file(src / f, dst / f, fs::copy_options::overwrite_existing);
@@ -265,9 +266,9 @@ int runBatch(const std::vector<std::string>& argv) {
   std::vector<FleetEntry> entries;
   for (const auto& e : readFleetEntries(out))
     for (const auto& j : jobs)
-      if (e.status.value("record", "") == j.record.name &&
-          e.status.value("index", size_t(0)) == j.record.index &&
-          e.status.value("settings_hash", "") == j.settings_hash) {
+      if (stringField(e.status, "record") == j.record.name &&
+          intField(e.status, "index", -1) == static_cast<long long>(j.record.index) &&
+          stringField(e.status, "settings_hash") == j.settings_hash) {
         entries.push_back(e);
         break;
       }
@@ -278,7 +279,7 @@ int runBatch(const std::vector<std::string>& argv) {
   for (const auto& j : jobs) expected.push_back(j.record.index);
   writeFleetTable(entries, records.size(), expected, out, stem);
   size_t failed = 0;
-  for (const auto& e : entries) failed += e.status.value("exit_status", 1) != 0;
+  for (const auto& e : entries) failed += intField(e.status, "exit_status", 1) != 0;
   std::cerr << "batch: " << entries.size() << " records in " << out << "/" << stem << ".csv ("
             << failed << " failed: their exit status and message are in the table); ran " << sum.ran
             << ", skipped " << sum.skipped << "\n";

@@ -9,6 +9,7 @@
 
 #include "batch_runner.h"
 #include "cvg_bench/core/model/errors.h"
+#include "json_fields.h"
 
 namespace cvg_bench {
 namespace tools {
@@ -38,14 +39,12 @@ std::string joined(const nlohmann::json& arr, const char* sep) {
 }
 
 std::string verdictOf(const nlohmann::json& status, const nlohmann::json& result) {
-  if (status.value("exit_status", 1) != 0 || !result.is_object()) return "failed";
+  if (intField(status, "exit_status", 1) != 0 || !result.is_object()) return "failed";
   if (result.contains("unexplained"))
-    return result["unexplained"].get<bool>() ? "unexplained" : "explained";
+    return boolField(result, "unexplained", true) ? "unexplained" : "explained";
   const nlohmann::json& e = estimateOf(result);
-  const bool flagged =
-      (e.contains("adequate") && e["adequate"].is_boolean() && !e["adequate"].get<bool>()) ||
-      nonEmptyArray(e, "flags") || nonEmptyArray(e, "not_identified") ||
-      nonEmptyArray(e, "unidentifiable");
+  const bool flagged = !boolField(e, "adequate", true) || nonEmptyArray(e, "flags") ||
+                       nonEmptyArray(e, "not_identified") || nonEmptyArray(e, "unidentifiable");
   return flagged ? "flagged" : "ok";
 }
 
@@ -87,21 +86,24 @@ void flatten(const ojson& row, std::vector<std::pair<std::string, ojson>>& out) 
 
 ojson fleetRow(const FleetEntry& e) {
   ojson row;
-  row["record"] = e.status.value("record", "");
-  row["input"] = e.status.value("input", "");
-  row["columns"] = e.status.contains("columns") ? ojson(e.status["columns"]) : ojson::object();
-  row["exit_status"] = e.status.value("exit_status", 1);
+  row["record"] = stringField(e.status, "record");
+  row["input"] = stringField(e.status, "input");
+  row["columns"] = ojson::object();
+  if (e.status.contains("columns") && e.status["columns"].is_object())
+    for (auto c = e.status["columns"].begin(); c != e.status["columns"].end(); ++c)
+      if (c->is_string()) row["columns"][c.key()] = *c;
+  row["exit_status"] = intField(e.status, "exit_status", 1);
   row["verdict"] = verdictOf(e.status, e.result);
-  row["message"] = e.status.value("message", "");
-  row["json"] = e.status.value("json", "");
+  row["message"] = stringField(e.status, "message");
+  row["json"] = stringField(e.status, "json");
   if (!e.result.is_object()) return row;
   const nlohmann::json& est = estimateOf(e.result);
-  if (e.result.contains("selected"))
+  if (e.result.contains("selected") && e.result["selected"].is_array())
     row["model"] = std::string("linear") + (e.result["selected"].empty() ? "" : "+") +
                    joined(e.result["selected"], "+");
   else
-    row["model"] = est.value("model", "");
-  row["flags"] = joined(est.value("flags", nlohmann::json::array()), ";");
+    row["model"] = stringField(est, "model");
+  row["flags"] = est.contains("flags") ? joined(est["flags"], ";") : "";
   if (est.contains("not_identified") && est["not_identified"].is_array())
     row["not_identified"] = joined(est["not_identified"], ";");
   if (est.contains("frequency_hz") && est["frequency_hz"].is_number())
@@ -123,7 +125,7 @@ void writeFleetTable(std::vector<FleetEntry> entries, size_t record_count,
                      const std::vector<size_t>& expected, const std::string& dir,
                      const std::string& stem) {
   std::sort(entries.begin(), entries.end(), [](const FleetEntry& a, const FleetEntry& b) {
-    return a.status.value("index", size_t(0)) < b.status.value("index", size_t(0));
+    return intField(a.status, "index", 0) < intField(b.status, "index", 0);
   });
   std::vector<std::string> columns;
   std::set<std::string> seen;
@@ -134,7 +136,7 @@ void writeFleetTable(std::vector<FleetEntry> entries, size_t record_count,
   for (const auto& e : entries) {
     const ojson row = fleetRow(e);
     records.push_back(row);
-    present.insert(e.status.value("index", size_t(0)));
+    present.insert(static_cast<size_t>(intField(e.status, "index", 0)));
     if (row["exit_status"] != 0) ++failed;
     flat.emplace_back();
     flatten(row, flat.back());
@@ -185,7 +187,7 @@ std::vector<FleetEntry> readFleetEntries(const std::string& dir) {
     FleetEntry e;
     e.status = readBatchStatus(f.string());
     if (e.status.empty()) continue;
-    const std::string js = e.status.value("json", "");
+    const std::string js = stringField(e.status, "json");
     if (!js.empty()) {
       std::ifstream in(records / js);
       e.result = nlohmann::json::parse(in, nullptr, false);

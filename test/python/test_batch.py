@@ -150,6 +150,28 @@ class Batch(unittest.TestCase):
         p = run(["batch", man, "--mode", "ringdown", "--confidence", "0.9", "--out", o, "--no-plots"], check=0)
         self.assertIn("ran 7, skipped 0", p.stderr)
 
+    def test_corrupt_status_files_are_rerun_not_trusted(self):
+        o = self.out("corrupt")
+        shutil.copytree(self.serial, o)
+        st = os.path.join(o, "records", "rd2.status.json")
+        with open(st) as f:
+            s = json.load(f)
+        s["exit_status"] = "0"  # hand-edited: a string
+        with open(st, "w") as f:
+            json.dump(s, f)
+        with open(os.path.join(o, "records", "rd3.status.json"), "w") as f:
+            f.write('{"record": "rd3", "compl')  # truncated
+        s4 = os.path.join(o, "records", "rd4.status.json")
+        with open(s4) as f:
+            s = json.load(f)
+        s["record"] = "../../escape"
+        with open(s4, "w") as f:
+            json.dump(s, f)
+        p = run(["batch", self.manifest, "--mode", "ringdown", "--out", o, "--no-plots"], check=0)
+        self.assertIn("ran 3, skipped 4", p.stderr)
+        with open(os.path.join(self.serial, "fleet.csv")) as a, open(os.path.join(o, "fleet.csv")) as b:
+            self.assertEqual(a.read(), b.read())
+
     def test_killed_batch_resumes_to_the_same_table(self):
         o = self.out("killed")
         proc = subprocess.Popen([TOOL, "batch", self.manifest, "--mode", "ringdown", "--jobs", "1",
