@@ -7,9 +7,7 @@
 
 #include "bag_input.h"
 #include "cli_args.h"
-#include "cvg_bench/core/demod/demodulator.h"
-#include "cvg_bench/core/demod/frequency_estimator.h"
-#include "cvg_bench/core/demod/irregular_demodulator.h"
+#include "cvg_bench/core/demod/raw_record_demodulation.h"
 #include "cvg_bench/core/diagnose/explanation.h"
 #include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
@@ -55,42 +53,6 @@ std::vector<std::string> splitList(const std::string& s) {
   while (std::getline(ss, item, ','))
     if (!item.empty()) out.push_back(item);
   return out;
-}
-
-/// Raw t,f,g -> slow q: reference frequency from --omega / the file, else estimated; uniform
-/// timestamps by the FIR demodulator, irregular ones by windowed least squares (2 periods per
-/// window, one output per period).
-SlowRecord demodulateRaw(const RawRecord& raw, double omega, std::vector<std::string>* notes) {
-  std::ostringstream s;
-  s << std::setprecision(8) << "input " << raw.source << " is a raw t,f,g record";
-  if (raw.n_reordered > 0 || raw.n_duplicates_dropped > 0)
-    s << " (" << raw.n_reordered << " rows reordered, " << raw.n_duplicates_dropped
-      << " duplicated timestamps dropped)";
-  if (!(omega > 0.0)) {
-    const FrequencyEstimate fe = estimateFrequency(raw.t_s, raw.f, raw.g);
-    omega = fe.omega_rad_s;
-    s << "; reference frequency estimated: W = " << omega << " +/- " << fe.std_rad_s << " rad/s ("
-      << fe.method << ")";
-  }
-  SlowRecord slow;
-  if (summarizeSampling(raw.t_s).uniform) {
-    DemodulatorOptions d;
-    d.omega_rad_s = omega;
-    slow = demodulateUniform(raw, d);
-    s << "; demodulated at W = " << omega << " rad/s (uniform FIR path)";
-  } else {
-    IrregularDemodulatorOptions d;
-    d.omega_rad_s = omega;
-    d.output_rate_hz = omega / (2.0 * M_PI);
-    slow = demodulateIrregular(raw, d).record;
-    s << "; demodulated at W = " << omega
-      << " rad/s by windowed least squares (irregular timestamps; window 2 periods, one output "
-         "per period)";
-  }
-  slow.omega_rad_s = omega;
-  s << " into " << slow.size() << " slow samples";
-  notes->push_back(s.str());
-  return slow;
 }
 
 void printSummary(const Explanation& x) {
@@ -162,8 +124,8 @@ int runExplain(const std::vector<std::string>& argv) {
   if (mode == ExperimentMode::kFreeDecay) {
     if (rec.kind == RecordKind::kForcedSweep)
       throw InputError(input + ": a forced sweep (omega0,q1,...) given with --mode free_decay");
-    const double omega = id.omega_rad_s > 0 ? id.omega_rad_s : rec.omegaRadS();
-    slow = rec.kind == RecordKind::kRaw ? demodulateRaw(rec.raw, omega, &input_notes) : rec.slow;
+    slow = rec.kind == RecordKind::kRaw ? demodulateRawRecord(rec.raw, id.omega_rad_s, input_notes)
+                                        : rec.slow;
     if (!(id.omega_rad_s > 0.0) && slow.omega_rad_s > 0.0) id.omega_rad_s = slow.omega_rad_s;
     x = explainFreeDecay(slow, options);
   } else {

@@ -10,9 +10,7 @@
 
 #include "bag_input.h"
 #include "cli_args.h"
-#include "cvg_bench/core/demod/demodulator.h"
-#include "cvg_bench/core/demod/frequency_estimator.h"
-#include "cvg_bench/core/demod/irregular_demodulator.h"
+#include "cvg_bench/core/demod/raw_record_demodulation.h"
 #include "cvg_bench/core/estimate/identify_pipeline.h"
 #include "cvg_bench/core/io/record_io.h"
 #include "cvg_bench/core/model/errors.h"
@@ -30,13 +28,14 @@ const char* kHelp =
     "usage: cvg_ident identify INPUT --mode free_decay|forced --model TERMS [--method "
     "ls|rls|ceres]\n"
     "                          [--confidence P] [--omega W] [--angular-gain K] [--mu MU]\n"
-    "                          [--json FILE]\n"
+    "                          [--columns t=COL,f=COL,g=COL] [--json FILE]\n"
     "Estimates the model parameters with confidence intervals.\n"
     "  INPUT    CSV: t,q1,p1,q2,p2 (free decay), omega0,q1,p1,q2,p2 (forced sweep) or raw t,f,g\n"
     "           (free decay; demodulated first at --omega / the file's omega / estimated),\n"
     "           or a rosbag (.bag) of the project's SlowState / SweepPoint / RawSampleBatch "
     "messages\n"
     "  --topic  bag topic to read (default: the one topic of a project message type)\n"
+    "  --columns  raw input with other column names or orders (as explain and demod)\n"
     "  --model  linear, or +-joined extensions: xi, kappa, gamma_nl, cm_rate (free decay), "
     "xi_diff,\n"
     "           xi_k (second cubic invariant: precession proportional to r k),\n"
@@ -51,38 +50,6 @@ const char* kHelp =
     "(2.11).\n"
     "Exit 1 when the data cannot identify every parameter (the report says which and why).\n"
     "example: cvg_ident identify sweep.csv --mode forced --model xi+mu --method ceres\n";
-
-SlowRecord demodulateRaw(const RawRecord& raw, double omega_opt, std::vector<std::string>& notes) {
-  double omega = omega_opt > 0 ? omega_opt : raw.omega_rad_s;
-  if (!(omega > 0.0)) {
-    const FrequencyEstimate fe = estimateFrequency(raw.t_s, raw.f, raw.g);
-    omega = fe.omega_rad_s;
-    notes.push_back("reference frequency " + fe.method);
-  }
-  const SamplingSummary sampling = summarizeSampling(raw.t_s);
-  SlowRecord out;
-  if (sampling.uniform) {
-    DemodulatorOptions o;
-    o.omega_rad_s = omega;
-    o.sample_rate_hz = 1.0 / sampling.median_interval_s;
-    o.output_rate_hz = std::min(100.0, o.sample_rate_hz / 4.0);
-    out = demodulateUniform(raw, o);
-    notes.push_back("raw t,f,g demodulated first (FIR path, uniform timestamps) at omega = " +
-                    std::to_string(omega) + " rad/s to " + std::to_string(o.output_rate_hz) +
-                    " Hz slow samples");
-  } else {
-    IrregularDemodulatorOptions o;
-    o.omega_rad_s = omega;
-    out = demodulateIrregular(raw, o).record;
-    notes.push_back(
-        "raw t,f,g demodulated first (windowed least squares, irregular timestamps) "
-        "at omega = " +
-        std::to_string(omega) + " rad/s");
-  }
-  out.source = raw.source;
-  out.omega_rad_s = omega;
-  return out;
-}
 
 void printTable(const Estimate& e, std::ostream& os) {
   os << "mode " << experimentModeName(e.mode) << ", model " << e.model << ", method " << e.method
@@ -132,10 +99,10 @@ void printTable(const Estimate& e, std::ostream& os) {
 }  // namespace
 
 int runIdentify(const std::vector<std::string>& argv) {
-  const CliArgs args(
-      argv,
-      {"mode", "model", "method", "confidence", "omega", "angular-gain", "json", "mu", "topic"},
-      {});
+  const CliArgs args(argv,
+                     {"mode", "model", "method", "confidence", "omega", "angular-gain", "json",
+                      "mu", "topic", "columns"},
+                     {});
   if (args.help()) {
     std::cout << kHelp;
     return 0;
@@ -156,6 +123,7 @@ int runIdentify(const std::vector<std::string>& argv) {
   throwIfInvalid("invalid options", po.validate());
   RecordReadOptions ro;
   ro.repair_raw_timestamps = true;
+  if (args.has("columns")) ro.raw_columns = parseRawColumnMap(args.get("columns"));
   const AnyRecord any = readRecordInput(path, ro, args.get("topic"));
   std::vector<std::string> pre_notes;
   Estimate e;
@@ -165,7 +133,7 @@ int runIdentify(const std::vector<std::string>& argv) {
                        ": holds a forced sweep (omega0 column) but --mode free_decay was "
                        "given; use --mode forced");
     SlowRecord rec = any.kind == RecordKind::kRaw
-                         ? demodulateRaw(any.raw, opt.omega_rad_s, pre_notes)
+                         ? demodulateRawRecord(any.raw, opt.omega_rad_s, pre_notes)
                          : any.slow;
     if (rec.source.empty()) rec.source = path;
     e = identify(rec, po);

@@ -1,0 +1,91 @@
+"""The Florence pendulum as a new user hands it over (issue #25): the raw camera track with its
+start-up glitch, one path for `identify` and `explain` on a slow raw record, and a single bad sample
+that must not flip the verdict. Skipped when ../shared/data is absent."""
+import json
+import os
+import subprocess
+import tempfile
+import unittest
+
+import numpy as np
+
+ROOT = os.environ.get("CVG_BENCH_ROOT", os.path.join(os.path.dirname(__file__), "..", ".."))
+TOOL = os.path.join(ROOT, "bin", "cvg_ident")
+DATA = os.path.join(ROOT, "..", "shared", "data", "foucault_florence_2021", "2021_09_17_14_57_N.csv")
+COLUMNS = "t=time,f=x,g=y"
+
+
+def run(args):
+    return subprocess.run([TOOL] + args, capture_output=True, text=True, timeout=600)
+
+
+def write_tfg(path, t, x, y):
+    with open(path, "w") as f:
+        f.write("t,f,g\n")
+        for a, b, c in zip(t, x, y):
+            f.write("%r,%r,%r\n" % (a, b, c))
+
+
+@unittest.skipUnless(os.path.isfile(DATA), "../shared/data/foucault_florence_2021 absent")
+class FoucaultRawRecord(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        d = np.genfromtxt(DATA, delimiter=";", names=True)
+        cls.t, cls.x, cls.y = d["time"], d["x"].astype(float), d["y"].astype(float)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def explain(self, path, extra=()):
+        out = os.path.join(self.tmp.name, os.path.basename(path) + ".json")
+        p = run(["explain", path, "--mode", "free_decay", "--json", out] + list(extra))
+        self.assertEqual(p.returncode, 0, p.stderr)
+        with open(out) as f:
+            return json.load(f), p.stdout
+
+    def test_start_up_glitch_left_out_and_verdict_as_on_the_trimmed_track(self):
+        raw, text = self.explain(DATA, ["--columns", COLUMNS])
+        self.assertIn("the first 5 sample(s) left out (start-up glitch)", text)
+        # The same track with the 5 glitched frames cut by hand (docs/examples/foucault.md).
+        trimmed = os.path.join(self.tmp.name, "trimmed.csv")
+        write_tfg(trimmed, self.t[5:], self.x[5:], self.y[5:])
+        cut, text2 = self.explain(trimmed)
+        self.assertNotIn("bad samples", text2)
+        self.assertEqual(raw["selected"], cut["selected"])
+        self.assertEqual(raw["unexplained"], cut["unexplained"])
+
+    def test_a_misread_frame_in_the_middle_does_not_flip_the_verdict(self):
+        x, y = self.x[5:].copy(), self.y[5:].copy()
+        mid = len(x) // 2
+        x[mid] += 6 * np.ptp(x[mid - 50:mid + 50])  # one frame far off the swing
+        y[mid] -= 300.0
+        spiked = os.path.join(self.tmp.name, "spiked.csv")
+        write_tfg(spiked, self.t[5:], x, y)
+        trimmed = os.path.join(self.tmp.name, "trimmed_ref.csv")
+        write_tfg(trimmed, self.t[5:], self.x[5:], self.y[5:])
+        a, text = self.explain(spiked)
+        b, _ = self.explain(trimmed)
+        self.assertIn("1 isolated spike(s) left out", text)
+        self.assertEqual(a["selected"], b["selected"])
+
+    def test_identify_reads_the_slow_raw_record_as_explain_does(self):
+        out = os.path.join(self.tmp.name, "id.json")
+        p = run(["identify", DATA, "--columns", COLUMNS, "--mode", "free_decay", "--model", "linear", "--json", out])
+        self.assertIn(p.returncode, (0, 1), p.stderr)  # 1: parameters a single swing cannot separate
+        with open(out) as f:
+            e = json.load(f)
+        notes = " ".join(e["notes"])
+        self.assertIn("one output a period, window 2 periods", notes)
+        self.assertIn("start-up glitch", notes)
+        # The 2.81 s swing: W within 0.1 % of 2 pi / 2.81 s.
+        self.assertAlmostEqual(e["omega"], 2 * np.pi / 2.8085, delta=2.3e-3)
+        # The same demodulation as explain's: its notes name the same W and the same slow samples.
+        _, text = self.explain(DATA, ["--columns", COLUMNS])
+        demod = [n for n in e["notes"] if "is a raw t,f,g record" in n]
+        self.assertEqual(len(demod), 1)
+        self.assertIn(demod[0], text)
+
+if __name__ == "__main__":
+    unittest.main()
