@@ -184,8 +184,20 @@ ParameterFile readParameterFile(const std::string& path) {
     throw InputError(path + ": not valid JSON (" + e.what() + ")");
   }
   ParameterFile f;
+  // explain --json: the selected model's estimate is its "final" member (interfaces.md).
+  if (j.is_object() && !j.contains("parameters") && j.contains("final") && j["final"].is_object()) {
+    nlohmann::json final_estimate = j["final"];
+    j = std::move(final_estimate);
+  }
+  if (j.is_object() && j.contains("mode") && j["mode"].is_string() &&
+      (j["mode"] == "ringdown" || j["mode"] == "response"))
+    throw InputError(path + ": a " + j["mode"].get<std::string>() +
+                     " estimate (one mode) has no pattern drift; drift needs a two-mode model "
+                     "(identify or explain --mode free_decay|forced)");
   if (!j.is_object() || !j.contains("parameters") || !j["parameters"].is_object())
-    throw InputError(path + ": needs an object member \"parameters\"");
+    throw InputError(path +
+                     ": needs an object member \"parameters\" (identify --json) or "
+                     "\"final\" (explain --json)");
   if (!j.contains("omega") || !j["omega"].is_number())
     throw InputError(path + ": needs a number member \"omega\" (natural frequency, rad/s)");
   f.omega_rad_s = j["omega"].get<double>();
@@ -215,6 +227,22 @@ ParameterFile readParameterFile(const std::string& path) {
   }
   if (j.contains("covariance") && !j["covariance"].is_null())
     readCovariance(j["covariance"], path, &f);
+  if (j.contains("model") && j["model"].is_string()) f.model = j["model"].get<std::string>();
+  if (j.contains("derived_ci") && j["derived_ci"].is_object())
+    for (const auto& kv : j["derived_ci"].items()) {
+      const nlohmann::json& d = kv.value();
+      if (!d.is_object()) continue;
+      bool ok = true;
+      for (const char* key : {"value", "std", "ci_low", "ci_high"})
+        ok = ok && d.contains(key) && d[key].is_number();
+      if (!ok) continue;
+      ParameterEstimate pe;
+      pe.value = d["value"].get<double>();
+      pe.std_error = d["std"].get<double>();
+      pe.ci_low = d["ci_low"].get<double>();
+      pe.ci_high = d["ci_high"].get<double>();
+      f.derived_ci[kv.key()] = pe;
+    }
   return f;
 }
 

@@ -10,6 +10,7 @@
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
+#include "cvg_bench/core/model/orbit_rates_chain_rule.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
 
@@ -29,6 +30,7 @@ const char* kHelp =
     "(record amplitude units) and pattern angle theta [rad]; default r = 1, k = 0.01, a grid of 8\n"
     "angles on [0, pi/2). Also prints section 4's derived quantities (angular gain K, default "
     "0.4).\n"
+    "FILE.json: identify --json, or explain --json (its \"final\" model is used).\n"
     "When the params file carries a covariance (identify --json), every figure gets a confidence\n"
     "interval by the delta method (numerical Jacobian; the file's confidence and interval_dof).\n"
     "At one state (--r --k --theta) it also prints the amplitude envelope's decay rate\n"
@@ -42,13 +44,18 @@ const char* kHelp =
 nlohmann::json envelopeDecay(double r, double k, double theta, const UncertainParameters& up,
                              double omega_rad_s) {
   const OrbitElements e{r, k, theta, 0.0};
-  const ParameterEstimate rate =
-      deltaMethod([&](const ParameterValues& v) { return -2.0 * orbitRates(e, v).r_dot / r; }, up);
+  const ResonatorModel model = freeOscillationModelOf(up.values);
+  const ParameterEstimate rate = deltaMethod(
+      [&](const ParameterValues& v) { return -2.0 * orbitRatesOfModel(model, v, e).r_dot / r; },
+      up);
   nlohmann::json j = {{"decay_rate_1_s", rate.value},
                       {"Q", omega_rad_s / rate.value},
-                      {"method", "amplitude envelope decay -2 r'/r of (5.7) at (r, k, theta)"}};
-  std::cout << std::setprecision(6) << "envelope decay (5.7) at r = " << r << ", k = " << k
-            << ", theta = " << theta << ": -2 r'/r = " << rate.value
+                      {"method",
+                       "amplitude envelope decay -2 r'/r at (r, k, theta), r' by the chain rule "
+                       "over the averaged equations of " +
+                           model.spec() + " ((5.7) for the paper's terms)"}};
+  std::cout << std::setprecision(6) << "envelope decay (" << model.spec() << ") at r = " << r
+            << ", k = " << k << ", theta = " << theta << ": -2 r'/r = " << rate.value
             << " 1/s, Q = omega / rate = " << omega_rad_s / rate.value;
   if (!up.cov_names.empty()) {
     j["std_1_s"] = rate.std_error;
@@ -97,7 +104,12 @@ int runDrift(const std::vector<std::string>& argv) {
   up.dof = pf.dof;
   up.confidence = pf.confidence;
   const bool with_ci = !pf.cov_names.empty();
-  const auto derived = deriveQuantitiesWithIntervals(up, pf.omega_rad_s, gain);
+  // Section 4's figures as identify / explain reported them (each from what the record
+  // identifies, e.g. the envelope's Q when gamma is not identified); recomputed from the values
+  // only for a file without them (hand-written parameters).
+  const bool as_identified = !pf.derived_ci.empty();
+  const auto derived =
+      as_identified ? pf.derived_ci : deriveQuantitiesWithIntervals(up, pf.omega_rad_s, gain);
   const double to_deg_h = 180.0 / M_PI * 3600.0;
   nlohmann::json out;
   out["omega"] = pf.omega_rad_s;
@@ -118,7 +130,8 @@ int runDrift(const std::vector<std::string>& argv) {
   }
   nlohmann::json rows = nlohmann::json::array();
   std::cout << std::fixed << std::setprecision(4);
-  std::cout << "derived (section 4, K = " << gain << ")"
+  std::cout << (as_identified ? "derived (as the params file reports them)"
+                              : "derived (section 4, K = " + std::to_string(gain) + ")")
             << (with_ci ? ", +- half-width of the " + std::to_string(pf.confidence) + " CI" : "")
             << ":\n";
   for (const auto& kv : derived) {
@@ -126,7 +139,9 @@ int runDrift(const std::vector<std::string>& argv) {
     if (with_ci) std::cout << "  +- " << kv.second.ci_high - kv.second.value;
     std::cout << "\n";
   }
-  std::cout << "drift rate (5.9) at r = " << r << ", k = " << k << ":\n"
+  std::cout << "drift rate theta' of " << freeOscillationModelOf(up.values).spec()
+            << " (chain rule over its averaged equations; (5.9) for the paper's terms) at r = " << r
+            << ", k = " << k << ":\n"
             << "  theta [rad]   theta [deg]   drift [rad/s]   drift [deg/h]"
             << (with_ci ? "   +- CI [deg/h]" : "") << "\n";
   for (double th : thetas) {

@@ -23,6 +23,10 @@ struct ParameterFile {
   Eigen::MatrixXd covariance;
   int dof = 0;  ///< degrees of freedom for Student-t (0: normal quantile)
   double confidence = 0.95;
+  std::string model;  ///< the file's "model" ("" when absent)
+  /// The file's "derived_ci" (identify / explain's section-4 figures, each from what the record
+  /// identifies); empty when absent (hand-written parameters).
+  std::map<std::string, ParameterEstimate> derived_ci;
 };
 ParameterFile readParameterFile(const std::string& path);
 

@@ -8,6 +8,7 @@
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
+#include "cvg_bench/core/model/orbit_rates_chain_rule.h"
 
 namespace cvg_bench {
 
@@ -68,7 +69,13 @@ std::map<std::string, ParameterEstimate> deriveQuantitiesWithIntervals(const Unc
 
 ParameterEstimate driftRateWithInterval(double r, double k, double theta,
                                         const UncertainParameters& p) {
-  return deltaMethod([&](const ParameterValues& v) { return driftRate(r, k, theta, v); }, p);
+  // theta' by the chain rule over the averaged equations of the model the values hold (every
+  // registered term; (5.9) for the paper's terms): orbit_rates_chain_rule.h.
+  if (!std::isfinite(theta)) throw InputError("drift: theta must be finite");
+  const ResonatorModel model = freeOscillationModelOf(p.values);
+  const OrbitElements e{r, k, theta, 0.0};
+  return deltaMethod(
+      [&](const ParameterValues& v) { return orbitRatesOfModel(model, v, e).theta_dot; }, p);
 }
 
 ParameterEstimate qualityFactorFromRate(double omega_rad_s, double rate, double rate_variance,
@@ -123,12 +130,21 @@ void deriveFromIdentified(Estimate* e, double omega_rad_s, double angular_gain_k
     e->derived_method["Q_envelope"] = how;
     const bool gamma_unknown =
         contains(e->not_identified, "gamma") || contains(e->unidentifiable, "gamma");
-    if (gamma_unknown) {
+    // omega/gamma whose interval reaches 0 or below: the record does not bound gamma away from
+    // 0 (e.g. gamma_nl takes the damping), so it is no Q (issue #25: nothing not determined is
+    // printed as a number).
+    const auto q_gamma = e->derived.find("Q");
+    const bool gamma_unbounded = q_gamma != e->derived.end() &&
+                                 !(q_gamma->second.value > 0.0 && q_gamma->second.ci_low > 0.0);
+    if (gamma_unknown || gamma_unbounded) {
+      const std::string why =
+          gamma_unknown
+              ? "the split of the damping between gamma and the anisotropy b is not identified "
+                "by this record, so omega/gamma is not reported"
+              : "omega/gamma is not reported: its interval reaches 0 or below (gamma not bounded "
+                "away from 0 by this record)";
       e->derived["Q"] = q_env;
-      e->derived_method["Q"] =
-          "Q " + how +
-          "; the split of the damping between gamma and the anisotropy b is not "
-          "identified by this record, so omega/gamma is not reported";
+      e->derived_method["Q"] = "Q " + how + "; " + why;
     } else if (e->derived.count("Q")) {
       e->derived_method["Q"] = "omega/gamma";
     }

@@ -1,6 +1,7 @@
-// Bad single samples in raw records (raw_glitches.h): a spike is left out, a start-up glitch is cut,
-// a jump in the middle is kept and reported, and a clean noisy record loses nothing; the one raw
-// path (raw_record_demodulation.h) gives the clean record's slow samples when a glitch is added.
+// Bad single samples in raw records (raw_glitches.h): a spike is left out, a start-up glitch is
+// cut, a jump in the middle is kept and reported, and a clean noisy record loses nothing; the one
+// raw path (raw_record_demodulation.h) gives the clean record's slow samples when a glitch is
+// added.
 #include "cvg_bench/core/demod/raw_glitches.h"
 
 #include <gtest/gtest.h>
@@ -85,7 +86,8 @@ TEST(RawRecordDemodulation, GlitchDoesNotMoveTheSlowRecord) {
   double worst = 0.0;
   for (size_t i = 0; i < a.size(); ++i)
     for (int k = 0; k < 4; ++k) worst = std::max(worst, std::abs(a.q[i](k) - b.q[i](k)));
-  // Leaving one of ~48 samples of a window out moves q by about the noise's share (3 px / sqrt(48)).
+  // Leaving one of ~48 samples of a window out moves q by about the noise's share (3 px /
+  // sqrt(48)).
   EXPECT_LT(worst, 2.0);
 }
 

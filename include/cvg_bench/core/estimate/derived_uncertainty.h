@@ -1,7 +1,7 @@
 // Uncertainty of derived quantities by the delta method: var f(z) = J C J', J the numerical
 // Jacobian (central differences) of f at z-hat, C the estimate's covariance (the honest one).
 //  - section 4's quantities (deriveQuantities);
-//  - the drift rate theta' of (5.9) (orbit_elements.h driftRate) at (r, k, theta).
+//  - the drift rate theta' at (r, k, theta) of any model (orbit_rates_chain_rule.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -36,7 +36,8 @@ std::map<std::string, ParameterEstimate> deriveQuantitiesWithIntervals(const Unc
                                                                        double omega_rad_s,
                                                                        double angular_gain_k);
 
-/// The drift rate (5.9) [rad/s] at (r, k, theta) with its CI.
+/// The drift rate theta' [rad/s] at (r, k, theta) with its CI: the chain rule over the averaged
+/// equations of every term the values hold (orbit_rates_chain_rule.h; (5.9) for the paper's).
 ParameterEstimate driftRateWithInterval(double r, double k, double theta,
                                         const UncertainParameters& p);
 
