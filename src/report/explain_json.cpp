@@ -69,6 +69,52 @@ nlohmann::json signatureToJson(const ResidualSignature& sig) {
 
 }  // namespace
 
+namespace {
+
+nlohmann::json estimateWithCi(const ParameterEstimate& p, double scale = 1.0) {
+  return {{"value", p.value * scale},
+          {"std", p.std_error * scale},
+          {"ci_low", p.ci_low * scale},
+          {"ci_high", p.ci_high * scale}};
+}
+
+}  // namespace
+
+nlohmann::json orbitReadingToJson(const OrbitReading& m) {
+  constexpr double kDegH = 180.0 / M_PI * 3600.0;
+  nlohmann::json j;
+  j["what"] =
+      "model-free reading: orbit elements (5.2) of the slow samples in equal windows of time; "
+      "rates are least-squares slopes with HAC standard errors, the record's rate the mean of the "
+      "windows' with a Student-t interval from their scatter";
+  j["period_s"] = m.period_s;
+  j["n_samples"] = m.n_samples;
+  j["theta_rate_rad_s"] = estimateWithCi(m.theta_rate);
+  j["theta_rate_deg_h"] = estimateWithCi(m.theta_rate, kDegH);
+  // The angle of the (f, g) ellipse's major axis (a pendulum's swing plane) is 2 theta (5.2).
+  j["oscillation_plane_rate_deg_h"] = estimateWithCi(m.theta_rate, 2.0 * kDegH);
+  j["k_rate_per_s"] = estimateWithCi(m.k_rate);
+  j["model"] = m.model;
+  nlohmann::json w = nlohmann::json::array();
+  for (const auto& x : m.windows) {
+    nlohmann::json o = {{"t_start_s", x.t_start_s},
+                        {"t_end_s", x.t_end_s},
+                        {"n", x.n},
+                        {"r", x.r},
+                        {"k", x.k},
+                        {"theta_rad", x.theta_rad},
+                        {"theta_rate_deg_h", estimateWithCi(x.theta_rate, kDegH)},
+                        {"k_rate_per_s", estimateWithCi(x.k_rate)}};
+    o["Q"] = x.q.value > 0.0 ? estimateWithCi(x.q) : nlohmann::json(nullptr);
+    o["predicted_theta_rate_deg_h"] =
+        x.has_prediction ? estimateWithCi(x.predicted_theta_rate, kDegH) : nlohmann::json(nullptr);
+    w.push_back(o);
+  }
+  j["windows"] = w;
+  j["summary"] = m.summary;
+  return j;
+}
+
 nlohmann::json explanationToJson(const Explanation& x) {
   nlohmann::json j;
   j["mode"] = experimentModeName(x.mode);
@@ -105,6 +151,7 @@ nlohmann::json explanationToJson(const Explanation& x) {
   j["holdout"] = x.selection.holdout_description;
   j["notes"] = x.notes;
   j["final"] = estimateToJson(x.finalEstimate());
+  if (x.measured.valid) j["measured"] = orbitReadingToJson(x.measured);
   return j;
 }
 

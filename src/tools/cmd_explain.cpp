@@ -138,6 +138,7 @@ int runExplain(const std::vector<std::string>& argv) {
   x.notes.insert(x.notes.begin(), input_notes.begin(), input_notes.end());
   const nlohmann::json j = explanationToJson(x);
   printSummary(x);
+  if (x.measured.valid) std::cout << x.measured.summary << "\n";
   for (const auto& n : input_notes) std::cout << "note: " << n << "\n";
   if (args.has("json")) writeJsonFile(j, args.get("json"));
   if (args.has("report")) {

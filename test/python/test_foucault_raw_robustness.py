@@ -70,6 +70,28 @@ class FoucaultRawRecord(unittest.TestCase):
         self.assertIn("1 isolated spike(s) left out", text)
         self.assertEqual(a["selected"], b["selected"])
 
+    def test_measured_before_modelling(self):
+        """The tool's own model-free reading reaches the record's findings: the swing plane (2 theta)
+        turns at about 4.4 deg/h and stalls, the ellipse grows, Q rises as the swing shrinks."""
+        ex, text = self.explain(DATA, ["--columns", COLUMNS])
+        self.assertIn("measured, before any model", text)
+        m = ex["measured"]
+        self.assertAlmostEqual(m["period_s"], 2.809, delta=0.005)
+        plane = m["oscillation_plane_rate_deg_h"]
+        self.assertGreater(plane["value"], 3.0)
+        self.assertLess(plane["value"], 5.5)
+        self.assertGreater(plane["ci_low"], 0.0)
+        w = m["windows"]
+        self.assertEqual(len(w), 8)
+        first, last = 2 * w[0]["theta_rate_deg_h"]["value"], 2 * w[-1]["theta_rate_deg_h"]["value"]
+        self.assertGreater(first, 5.0)  # about +8 deg/h at the start
+        self.assertLess(2 * w[-1]["theta_rate_deg_h"]["ci_high"], 0.0)  # turned back by the end: the stall
+        self.assertGreater(abs(w[-1]["k"]), 10 * abs(w[0]["k"]))  # the ellipse grows
+        self.assertGreater(w[-1]["Q"]["value"], 1.1 * w[0]["Q"]["value"])  # Q rises as r falls
+        self.assertLess(w[-1]["r"], w[0]["r"])
+        # Each window carries the selected model's prediction beside the measurement.
+        self.assertTrue(all(x["predicted_theta_rate_deg_h"] is not None for x in w))
+
     def test_identify_reads_the_slow_raw_record_as_explain_does(self):
         out = os.path.join(self.tmp.name, "id.json")
         p = run(["identify", DATA, "--columns", COLUMNS, "--mode", "free_decay", "--model", "linear", "--json", out])

@@ -283,7 +283,13 @@ void throwIfInvalid(const ExplainOptions& options) {
 Explanation explainFreeDecay(const SlowRecord& record, const ExplainOptions& options) {
   throwIfInvalid(options);
   const auto fitter = makeFreeDecayFitter(record, options.fitting);
-  return explainWith(*fitter, ExperimentMode::kFreeDecay, options);
+  Explanation x = explainWith(*fitter, ExperimentMode::kFreeDecay, options);
+  const double omega = options.fitting.identification.omega_rad_s > 0.0
+                           ? options.fitting.identification.omega_rad_s
+                           : x.finalEstimate().omega_rad_s;
+  x.measured =
+      readOrbit(record, omega, &x.finalEstimate(), 8, options.fitting.identification.confidence);
+  return x;
 }
 
 Explanation explainForced(const SweepRecord& record, const ExplainOptions& options) {

@@ -27,6 +27,7 @@
 
 #include "cvg_bench/core/diagnose/forward_selection.h"
 #include "cvg_bench/core/diagnose/nested_model_fitters.h"
+#include "cvg_bench/core/diagnose/orbit_reading.h"
 #include "cvg_bench/core/diagnose/residual_noise_model.h"
 #include "cvg_bench/core/diagnose/residual_signature.h"
 #include "cvg_bench/core/io/records.h"
@@ -76,6 +77,9 @@ struct Explanation {
   bool unexplained = false;           ///< structure remains that no accepted extension removes
   std::string cause;                  ///< the verdict in words
   std::vector<std::string> notes;     ///< provenance and skipped candidates
+  /// Free decay: what the record shows before any model, beside the final model's drift
+  /// prediction (orbit_reading.h); not valid in forced mode.
+  OrbitReading measured;
   const Estimate& finalEstimate() const { return selection.final_fit.estimate; }
 };
 
