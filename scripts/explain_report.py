@@ -11,7 +11,7 @@ from the C++ core):
   residuals.csv  model,x,radial,tangential,amp2,theta  equation-error residuals of (2.8)/(3.4) per
                  block/point, projected on the amplitude (radial) and phase (tangential) directions
   signature.csv  model,variable,component,bin_center,mean,sem  binned residual means
-Writes into DIR: response.png (forced) or slow.png + orbit.png (free decay), residuals.png,
+Writes into DIR: response.png (forced) or slow.png + orbit.png + measured.png (free decay), residuals.png,
 signature.png and report.md.
 
 Usage: explain_report.py DIR
@@ -220,6 +220,50 @@ def plot_signature(path, explanation, out_dir):
     return "signature.png"
 
 
+def plot_measured(explanation, out_dir):
+    """Free decay: the model-free orbit reading (explain JSON "measured") per window: theta' measured
+    and predicted by the final model, amplitude r and quadrature k, and Q against amplitude."""
+    m = explanation.get("measured")
+    if not m or not m.get("windows"):
+        return None
+    w = m["windows"]
+    mid = [0.5 * (x["t_start_s"] + x["t_end_s"]) for x in w]
+    fig, axs = plt.subplots(1, 3, figsize=(14, 4))
+    meas = [x["theta_rate_deg_h"] for x in w]
+    axs[0].errorbar(mid, [v["value"] for v in meas],
+                    yerr=[[v["value"] - v["ci_low"] for v in meas], [v["ci_high"] - v["value"] for v in meas]],
+                    fmt="o-", color="k", label="measured")
+    pred = [(t, x["predicted_theta_rate_deg_h"]) for t, x in zip(mid, w) if x.get("predicted_theta_rate_deg_h")]
+    if pred:
+        axs[0].errorbar([t for t, _ in pred], [v["value"] for _, v in pred],
+                        yerr=[[v["value"] - v["ci_low"] for _, v in pred], [v["ci_high"] - v["value"] for _, v in pred]],
+                        fmt="s--", color="tab:red", label="predicted by %s" % m.get("model", "the model"))
+    axs[0].axhline(0.0, color="0.6", lw=0.8)
+    axs[0].set_xlabel("t [s]")
+    axs[0].set_ylabel("pattern angle rate theta' [deg/h]")
+    axs[0].set_title("theta' per window (oscillation plane: 2 theta')")
+    axs[0].legend(fontsize=8)
+    axs[1].plot(mid, [x["r"] for x in w], "o-", label="amplitude r")
+    axs[1].set_xlabel("t [s]")
+    axs[1].set_ylabel("r")
+    ax2 = axs[1].twinx()
+    ax2.plot(mid, [x["k"] for x in w], "s-", color="tab:orange", label="quadrature k")
+    ax2.set_ylabel("k", color="tab:orange")
+    axs[1].set_title("amplitude and quadrature (ellipse)")
+    qs = [(x["r"], x["Q"]) for x in w if x.get("Q")]
+    if qs:
+        axs[2].errorbar([r for r, _ in qs], [q["value"] for _, q in qs],
+                        yerr=[[q["value"] - q["ci_low"] for _, q in qs],
+                              [min(q["ci_high"], 10 * q["value"]) - q["value"] for _, q in qs]], fmt="o")
+    axs[2].set_xlabel("amplitude r")
+    axs[2].set_ylabel("Q = omega / (-2 r'/r)")
+    axs[2].set_title("Q against amplitude")
+    fig.tight_layout()
+    fig.savefig(os.path.join(out_dir, "measured.png"), dpi=110)
+    plt.close(fig)
+    return "measured.png"
+
+
 def fmt(v, spec="%.4g"):
     if v is None:
         return "-"
@@ -262,6 +306,18 @@ def write_markdown(explanation, figures, out_dir):
             lines.append("| %s | %s | %s | %s | %s |" % (
                 r["added"], fmt(r["f_statistic"]), fmt(r["p_value"], "%.2g"),
                 fmt(r.get("threshold"), "%.2g"), fmt(r["holdout_ratio"], "%.3g")))
+    m = e.get("measured")
+    if m:
+        lines += ["", "## Measured before modelling", "", m.get("summary", ""), "",
+                  "| window [s] | r | k | theta' [deg/h] | predicted [deg/h] | Q |", "|---|---|---|---|---|---|"]
+        for x in m.get("windows", []):
+            p = x.get("predicted_theta_rate_deg_h")
+            q = x.get("Q")
+            lines.append("| %.0f-%.0f | %.4g | %.4g | %.3g [%.3g, %.3g] | %s | %s |" % (
+                x["t_start_s"], x["t_end_s"], x["r"], x["k"], x["theta_rate_deg_h"]["value"],
+                x["theta_rate_deg_h"]["ci_low"], x["theta_rate_deg_h"]["ci_high"],
+                "%.3g [%.3g, %.3g]" % (p["value"], p["ci_low"], p["ci_high"]) if p else "-",
+                "%.4g" % q["value"] if q else "-"))
     final = e.get("final", {})
     params = final.get("parameters", {})
     if params:
@@ -300,6 +356,10 @@ def make_report(out_dir):
     if os.path.exists(res_path):
         res, _ = read_table(res_path)
         figures.append(plot_residuals(res, explanation, out_dir))
+    if explanation.get("measured"):
+        name = plot_measured(explanation, out_dir)
+        if name:
+            figures.append(name)
     sig_path = os.path.join(out_dir, "signature.csv")
     if os.path.exists(sig_path):
         name = plot_signature(sig_path, explanation, out_dir)
