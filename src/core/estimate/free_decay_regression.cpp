@@ -1,7 +1,9 @@
 #include "cvg_bench/core/estimate/free_decay_regression.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "cvg_bench/core/estimate/internal/regression_block_ops.h"
 #include "cvg_bench/core/model/errors.h"
@@ -48,6 +50,20 @@ bool hasUniformTimes(const SlowRecord& record, double relative_tolerance) {
   return true;
 }
 
+std::vector<size_t> timeGapsOf(const SlowRecord& record) {
+  const size_t n = record.size();
+  std::vector<size_t> gaps;
+  if (n < 8) return gaps;
+  std::vector<double> dt(n - 1);
+  for (size_t i = 0; i + 1 < n; ++i) dt[i] = record.t_s[i + 1] - record.t_s[i];
+  std::vector<double> sorted = dt;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double limit = 5.0 * sorted[sorted.size() / 2];
+  for (size_t i = 0; i + 1 < n; ++i)
+    if (dt[i] > limit) gaps.push_back(i);
+  return gaps;
+}
+
 void forEachFreeDecayBlock(const ResonatorModel& model, const SlowRecord& record,
                            double uniform_time_tolerance, const RegressionVisitor& visit) {
   validateFreeDecayRecord(record);
@@ -71,12 +87,16 @@ void forEachValidatedFreeDecayBlock(const ResonatorModel& model, const SlowRecor
   RegressionBlock b;
   b.d = &dbar;
   const size_t n = record.size();
+  // gap_after[i]: the step from sample i to i+1 is a gap.
+  std::vector<char> gap_after(n, 0);
+  for (size_t g : timeGapsOf(record)) gap_after[g] = 1;
   for (size_t i = 1; i + 1 < n; ++i) {
     RegressionBlockMatrix& prev = dm[(i - 1) % 3];
     RegressionBlockMatrix& mid = dm[i % 3];
     RegressionBlockMatrix& next = dm[(i + 1) % 3];
     ctx.t_s = record.t_s[i + 1] - t0;
     model.regressor(record.q[i + 1], ctx, next);
+    if (gap_after[i - 1] || gap_after[i]) continue;  // spans a gap
     if (simpson) {
       const double h = 0.5 * (record.t_s[i + 1] - record.t_s[i - 1]);
       b.weights[0] = b.weights[2] = h / 3.0;
@@ -96,7 +116,7 @@ void forEachValidatedFreeDecayBlock(const ResonatorModel& model, const SlowRecor
     b.q_next = record.q[i + 1];
     b.t_prev = record.t_s[i - 1] - t0;
     b.t_next = record.t_s[i + 1] - t0;
-    b.last_in_record = i + 2 == n;
+    b.last_in_record = i + 2 == n || (i + 2 < n && gap_after[i + 1]);
     visit(b);
   }
 }

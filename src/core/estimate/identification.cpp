@@ -599,6 +599,18 @@ Estimate identifyFreeDecayRecords(const std::vector<const SlowRecord*>& records,
         std::to_string(rec.size()) + " samples, integral of D(q) over [t_{i-1}, t_{i+1}] by " +
         (simpson[r] ? "Simpson's rule (uniform times)" : "the trapezoid rule (irregular times)") +
         ", y_i = 2 (q_{i+1} - q_{i-1}) (factor 1/2 of (2.7) kept)");
+    const std::vector<size_t> gaps = timeGapsOf(rec);
+    if (!gaps.empty()) {
+      std::string where;
+      for (size_t g = 0; g < gaps.size() && g < 5; ++g)
+        where +=
+            (g ? ", " : "") + fmt(rec.t_s[gaps[g]]) + " -> " + fmt(rec.t_s[gaps[g] + 1]) + " s";
+      info.notes.push_back(
+          (rec.source.empty() ? "record " + std::to_string(r) : rec.source) + ": " +
+          std::to_string(gaps.size()) + " gap(s) in time (a step over 5x the median: " + where +
+          (gaps.size() > 5 ? ", ..." : "") +
+          "): the equations spanning them are left out, not integrated across the gap");
+    }
   }
   if (records.size() > 1)
     info.notes.push_back(std::to_string(records.size()) + " records stacked into one regression");

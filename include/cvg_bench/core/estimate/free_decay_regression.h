@@ -37,7 +37,13 @@ void validateFreeDecayRecord(const SlowRecord& record);
 /// Whether the record's time steps are uniform within relative_tolerance (Simpson) or not.
 bool hasUniformTimes(const SlowRecord& record, double relative_tolerance);
 
-/// Calls visit for each block i = 1..N-1 of the record (validated first).
+/// The samples after which the record has a gap in time: steps over 5 x the median step (rows
+/// missing, a clock jump; issue #27). An equation (2.7) differences samples i-1 and i+1 and
+/// integrates D(q) between them: one that spans a gap is left out (not integrated across it).
+std::vector<size_t> timeGapsOf(const SlowRecord& record);
+
+/// Calls visit for each block i = 1..N-1 of the record (validated first), except the blocks that
+/// span a gap (timeGapsOf); the block before a gap is marked last_in_record (no lag across it).
 void forEachFreeDecayBlock(const ResonatorModel& model, const SlowRecord& record,
                            double uniform_time_tolerance, const RegressionVisitor& visit);
 /// The same for a record already checked by validateFreeDecayRecord, with the quadrature chosen
