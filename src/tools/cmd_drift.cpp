@@ -2,12 +2,16 @@
 // (r, k, theta) or over a theta grid on [0, pi/2), from an identify JSON (or a flat parameter
 // file).
 #include <cmath>
+#include <cstdlib>
 #include <iomanip>
 #include <iostream>
 
+#include "bag_input.h"
 #include "cli_args.h"
+#include "cvg_bench/core/diagnose/drift_measurement.h"
 #include "cvg_bench/core/estimate/derived_quantities.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/io/record_io.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"
@@ -24,6 +28,7 @@ namespace {
 
 const char* kHelp =
     "usage: cvg_ident drift --params FILE.json [--r R --k K --theta TH | --theta-grid N]\n"
+    "       cvg_ident drift --params FILE.json --measured RECORD [--walk RAD_S] [--bins N]\n"
     "                       [--angular-gain K] [--json FILE]\n"
     "Drift rate theta' of (5.9) [rad/s and deg/h] of the wave pattern at amplitude r, quadrature "
     "k\n"
@@ -35,6 +40,11 @@ const char* kHelp =
     "interval by the delta method (numerical Jacobian; the file's confidence and interval_dof).\n"
     "At one state (--r --k --theta) it also prints the amplitude envelope's decay rate\n"
     "-2 r'/r of (5.7) and the Q = omega / rate it implies (JSON \"envelope\").\n"
+    "--measured RECORD: theta'(theta) measured in a whole-angle run (simulate --mode\n"
+    "whole_angle; the walk from its # whole_angle_walk_rad_s line or --walk) in --bins theta bins\n"
+    "(default 24) beside the model's prediction; harmonics, RMS difference and the residual drift\n"
+    "after compensation with the prediction (JSON theta_deg, measured_deg_h, measured_ci,\n"
+    "predicted_deg_h, predicted_ci, harmonics, rms_difference_deg_h, ...).\n"
     "example: cvg_ident drift --params est.json --r 0.5 --k 0.1 --theta 0.3\n";
 
 /// The amplitude envelope's decay at one state, from (5.7): rate = -2 r'/r [1/s] and the quality
@@ -73,8 +83,89 @@ nlohmann::json envelopeDecay(double r, double k, double theta, const UncertainPa
 
 }  // namespace
 
+/// --measured: theta'(theta) measured in a whole-angle record against the prediction
+/// (drift_measurement.h); JSON arrays per theta bin as interfaces.md names them.
+int runMeasuredDrift(const CliArgs& args, const UncertainParameters& up) {
+  RecordReadOptions ro;
+  const std::string path = args.get("measured");
+  const AnyRecord any = readRecordInput(path, ro, "");
+  if (any.kind != RecordKind::kFreeDecay)
+    throw InputError(path + ": --measured needs a slow record t,q1,p1,q2,p2 of a whole-angle run");
+  double walk = args.getDouble("walk", 0.0);
+  if (!args.has("walk")) {
+    const auto it = any.slow.metadata.find("whole_angle_walk_rad_s");
+    if (it != any.slow.metadata.end()) walk = std::strtod(it->second.c_str(), nullptr);
+  }
+  const long bins = args.getInt("bins", 24);
+  const DriftComparison c = measureDrift(any.slow, walk, up, static_cast<int>(bins), up.confidence);
+  const double dh = 180.0 / M_PI * 3600.0;
+  nlohmann::json j;
+  nlohmann::json th = nlohmann::json::array(), m = nlohmann::json::array(),
+                 mci = nlohmann::json::array(), p = nlohmann::json::array(),
+                 pci = nlohmann::json::array(), passes = nlohmann::json::array();
+  std::cout << std::setprecision(5) << c.summary << "\n  theta [deg]   measured [deg/h]   "
+            << "predicted [deg/h]\n";
+  for (const auto& b : c.bins) {
+    th.push_back(b.theta_rad * 180.0 / M_PI);
+    passes.push_back(b.passes);
+    if (b.measured_ok) {
+      m.push_back(b.measured.value * dh);
+      mci.push_back({b.measured.ci_low * dh, b.measured.ci_high * dh});
+    } else {
+      m.push_back(nullptr);
+      mci.push_back(nullptr);
+    }
+    p.push_back(b.predicted.value * dh);
+    pci.push_back({b.predicted.ci_low * dh, b.predicted.ci_high * dh});
+    std::cout << "  " << std::setw(11) << b.theta_rad * 180 / M_PI << "   " << std::setw(16)
+              << (b.measured_ok ? std::to_string(b.measured.value * dh) : std::string("-")) << "   "
+              << std::setw(16) << b.predicted.value * dh << "\n";
+  }
+  auto harm = [&](const DriftHarmonics& h) {
+    return nlohmann::json{{"c0_deg_h", h.c0 * dh},
+                          {"cos4_deg_h", h.a4 * dh},
+                          {"sin4_deg_h", h.b4 * dh},
+                          {"amp4_deg_h", std::hypot(h.a4, h.b4) * dh},
+                          {"cos8_deg_h", h.a8 * dh},
+                          {"sin8_deg_h", h.b8 * dh},
+                          {"amp8_deg_h", std::hypot(h.a8, h.b8) * dh}};
+  };
+  j["theta_deg"] = th;
+  j["measured_deg_h"] = m;
+  j["measured_ci"] = mci;
+  j["predicted_deg_h"] = p;
+  j["predicted_ci"] = pci;
+  j["passes"] = passes;
+  j["harmonics"] = {{"measured", harm(c.measured_harmonics)},
+                    {"predicted", harm(c.predicted_harmonics)},
+                    {"residual", harm(c.residual_harmonics)},
+                    {"note",
+                     "theta is defined modulo pi/2: the drift's harmonics are 4 theta and "
+                     "8 theta (2 theta and 4 theta of the oscillation plane 2 theta)"}};
+  j["rms_measured_deg_h"] = c.rms_measured_rad_s * dh;
+  j["rms_difference_deg_h"] = c.rms_difference_rad_s * dh;
+  j["residual_after_compensation_deg_h"] = c.rms_difference_rad_s * dh;
+  j["compensation_gain"] = c.rms_difference_rad_s > 0
+                               ? nlohmann::json(c.rms_measured_rad_s / c.rms_difference_rad_s)
+                               : nlohmann::json(nullptr);
+  j["r"] = c.r;
+  j["k"] = c.k;
+  j["walk_deg_h"] = c.walk_rad_s * dh;
+  j["model"] = c.model;
+  j["confidence"] = up.confidence;
+  j["method"] =
+      "measured: slopes of the unwrapped pattern angle over passes through each theta bin, walk "
+      "subtracted, mean of passes with a Student-t interval (one pass: HAC); predicted: theta' of "
+      "the model by the chain rule at the run's median r, k, delta-method interval";
+  if (args.has("json")) writeJsonFile(j, args.get("json"));
+  return 0;
+}
+
 int runDrift(const std::vector<std::string>& argv) {
-  const CliArgs args(argv, {"params", "r", "k", "theta", "theta-grid", "json", "angular-gain"}, {});
+  const CliArgs args(argv,
+                     {"params", "r", "k", "theta", "theta-grid", "json", "angular-gain", "measured",
+                      "walk", "bins"},
+                     {});
   if (args.help()) {
     std::cout << kHelp;
     return 0;
@@ -104,6 +195,7 @@ int runDrift(const std::vector<std::string>& argv) {
   up.dof = pf.dof;
   up.confidence = pf.confidence;
   const bool with_ci = !pf.cov_names.empty();
+  if (args.has("measured")) return runMeasuredDrift(args, up);
   // Section 4's figures as identify / explain reported them (each from what the record
   // identifies, e.g. the envelope's Q when gamma is not identified); recomputed from the values
   // only for a file without them (hand-written parameters).

@@ -8,6 +8,7 @@
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_preset.h"
 #include "cvg_bench/core/simulate/experiment_runner.h"
+#include "cvg_bench/core/simulate/whole_angle_simulator.h"
 #include "cvg_ident_commands.h"
 
 namespace cvg_bench {
@@ -15,7 +16,8 @@ namespace tools {
 namespace {
 
 const char* kHelp =
-    "usage: cvg_ident simulate --preset NAME|--config FILE --mode free_decay|forced [--raw]\n"
+    "usage: cvg_ident simulate --preset NAME|--config FILE --mode free_decay|forced|whole_angle\n"
+    "                          [--raw]\n"
     "                          [--seed N] [--effect NAME=VALUE ...] [--noise STD]\n"
     "                          [--duration S] [--start R,K,THETA] --out FILE\n"
     "Simulates a record of a resonator preset and writes it as CSV with `# omega:`, `# mode:` and\n"
@@ -28,6 +30,11 @@ const char* kHelp =
     "                    forced: stepped sweep of the detuning, stationary q per step\n"
     "                    (omega0,q1,p1,q2,p2,direction,jump; jump = 1 marks a branch jump of a\n"
     "                    bistable resonator)\n"
+    "                    whole_angle: amplitude and quadrature held by control loops, the\n"
+    "                    pattern angle walked over 1.5 periods by a base rotation (t,q1,p1,q2,p2\n"
+    "                    with # whole_angle_* lines; measure its drift with drift --measured)\n"
+    "  --amplitude R --quadrature K --walk RAD_S   whole_angle: held r (default 0.5), k (0) and\n"
+    "                    the walk of theta (default 1.5 x pi/2 over the run)\n"
     "  --raw             raw f, g of the full equations (2.3)/(3.1) instead (t,f,g); forced: one\n"
     "                    segment per settled step with columns omega0 and drive_phase_rad\n"
     "  --seed N          seed of the Gaussian measurement noise (default 1)\n"
@@ -48,7 +55,8 @@ const char* kHelp =
 
 int runSimulate(const std::vector<std::string>& argv) {
   const CliArgs args(argv,
-                     {"preset", "config", "mode", "seed", "out", "noise", "duration", "start"},
+                     {"preset", "config", "mode", "seed", "out", "noise", "duration", "start",
+                      "amplitude", "quadrature", "walk"},
                      {"raw"}, {"effect"});
   if (args.help()) {
     std::cout << kHelp;
@@ -58,13 +66,36 @@ int runSimulate(const std::vector<std::string>& argv) {
     throw InputError("unexpected argument '" + args.positionals().front() + "' (see --help)");
   if (args.has("preset") == args.has("config"))
     throw InputError("give exactly one of --preset NAME or --config FILE (see --help)");
-  if (!args.has("mode")) throw InputError("--mode free_decay|forced is required");
+  if (!args.has("mode")) throw InputError("--mode free_decay|forced|whole_angle is required");
   if (!args.has("out")) throw InputError("--out FILE is required");
   if (args.has("config")) requireInputFile(args.get("config"), "--config preset file");
   requireOutputFile(args.get("out"), "--out");
   ResonatorPreset preset = args.has("preset") ? loadShippedPreset(args.get("preset"))
                                               : loadResonatorPresetFile(args.get("config"));
   for (const auto& e : args.getAll("effect")) preset.applyEffect(e);
+  if (args.get("mode") == "whole_angle") {
+    // Amplitude and quadrature held by loops, the pattern walked (whole_angle_simulator.h).
+    WholeAngleOptions wa;
+    wa.r0 = args.getDouble("amplitude", wa.r0);
+    wa.k0 = args.getDouble("quadrature", wa.k0);
+    wa.walk_rad_s = args.getDouble("walk", 0.0);
+    wa.duration_s = args.getDouble("duration", 0.0);
+    wa.noise_std = args.getDouble("noise", -1.0);
+    if (args.has("noise") && wa.noise_std < 0) throw InputError("--noise must be >= 0");
+    if (args.has("duration") && wa.duration_s <= 0) throw InputError("--duration must be > 0");
+    const long seed = args.getInt("seed", 1);
+    if (seed < 0) throw InputError("--seed must be >= 0");
+    wa.seed = static_cast<std::uint64_t>(seed);
+    SlowRecord rec = simulateWholeAngle(preset, wa);
+    writeSlowRecordCsv(rec, args.get("out"));
+    std::cerr << "simulate: " << rec.size() << " whole-angle samples (walk "
+              << rec.metadata.at("whole_angle_walk_rad_s") << " rad/s) -> " << args.get("out")
+              << "\n";
+    return 0;
+  }
+  for (const char* o : {"amplitude", "quadrature", "walk"})
+    if (args.has(o))
+      throw InputError(std::string("--") + o + " applies to --mode whole_angle only");
   SimulationOptions options;
   options.mode = parseExperimentMode(args.get("mode"));
   options.raw = args.has("raw");

@@ -1,12 +1,11 @@
 #include "cvg_bench/core/diagnose/orbit_reading.h"
 
-#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
-#include "cvg_bench/core/estimate/hac_covariance.h"
+#include "cvg_bench/core/estimate/internal/hac_slope.h"
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 
@@ -21,31 +20,6 @@ double median(std::vector<double> v) {
   const size_t m = v.size() / 2;
   std::nth_element(v.begin(), v.begin() + m, v.end());
   return v[m];
-}
-
-/// Slope of y on t by least squares with a HAC standard error and a Student-t interval.
-ParameterEstimate slope(const std::vector<double>& t, const std::vector<double>& y,
-                        double confidence) {
-  const int n = static_cast<int>(t.size());
-  ParameterEstimate p;
-  if (n < 6) return p;
-  Eigen::MatrixXd j(n, 2);
-  Eigen::VectorXd v(n);
-  const double t0 = t[n / 2];
-  for (int i = 0; i < n; ++i) {
-    j(i, 0) = 1.0;
-    j(i, 1) = t[i] - t0;
-    v(i) = y[i];
-  }
-  const Eigen::VectorXd beta = j.colPivHouseholderQr().solve(v);
-  const Eigen::VectorXd e = v - j * beta;
-  const HacCovariance h = hacCovariance(j, e);
-  p.value = beta(1);
-  p.std_error = std::sqrt(std::max(0.0, h.covariance(1, 1)));
-  const double s = studentQuantile(confidence, n - 2);
-  p.ci_low = p.value - s * p.std_error;
-  p.ci_high = p.value + s * p.std_error;
-  return p;
 }
 
 /// Mean of window values with a Student-t interval from their scatter.
@@ -135,11 +109,11 @@ OrbitReading readOrbit(const SlowRecord& record, double omega_rad_s, const Estim
     win.r = median(rw);
     win.k = median(kw);
     win.theta_rad = std::remainder(median(thw), M_PI / 2);
-    win.theta_rate = slope(tw, thw, confidence);
-    win.k_rate = slope(tw, kw, confidence);
+    win.theta_rate = hacSlope(tw, thw, confidence);
+    win.k_rate = hacSlope(tw, kw, confidence);
     std::vector<double> lnr(rw.size());
     for (size_t i = 0; i < rw.size(); ++i) lnr[i] = std::log(rw[i]);
-    const ParameterEstimate lam = slope(tw, lnr, confidence);
+    const ParameterEstimate lam = hacSlope(tw, lnr, confidence);
     if (omega > 0.0 && -2.0 * lam.value > 0.0) {
       try {
         win.q = qualityFactorFromRate(omega, -2.0 * lam.value, 4.0 * lam.std_error * lam.std_error,

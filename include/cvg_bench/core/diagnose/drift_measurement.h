@@ -1,0 +1,55 @@
+// Drift measured in a whole-angle run against the identified model's prediction (issue #26): the
+// identify -> predict chain closed on a record, and what compensation with the prediction leaves.
+//
+// Measured: the pattern angle theta of every slow sample ((5.2), unwrapped), binned over one period
+// of theta (pi/2, where theta is defined); a pass is a run of consecutive samples in one bin that
+// crosses at least half of it; its rate is the least-squares slope of theta on t (HAC standard
+// error: correlated noise inside a pass stays honest) minus the known walk (base rotation). A
+// bin's measured theta' is the inverse-variance mean of its passes, its std scaled by the Birge
+// ratio when they scatter more than their intervals say (Student-t, passes - 1 dof), or the one
+// pass's own.
+// Predicted: theta' of the model (chain rule, every term) at the run's median r, k and the bin's
+// centre, with its delta-method interval. Harmonics: least squares of c0 + a4 cos 4 theta +
+// b4 sin 4 theta + a8 cos 8 theta + b8 sin 8 theta (theta is defined modulo pi / 2, so the drift's
+// harmonics are multiples of 4 theta; the oscillation plane 2 theta sees them as 2 theta and 4
+// theta).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/io/records.h"
+
+namespace cvg_bench {
+
+struct DriftBin {
+  double theta_rad = 0.0;  ///< bin centre in [-pi/4, pi/4)
+  int samples = 0, passes = 0;
+  bool measured_ok = false;
+  ParameterEstimate measured;   ///< [rad/s]
+  ParameterEstimate predicted;  ///< [rad/s]
+};
+
+struct DriftHarmonics {
+  double c0 = 0.0, a4 = 0.0, b4 = 0.0, a8 = 0.0, b8 = 0.0;  ///< [rad/s]
+};
+
+struct DriftComparison {
+  std::vector<DriftBin> bins;
+  double r = 0.0, k = 0.0;  ///< medians over the run
+  double walk_rad_s = 0.0;  ///< subtracted from the measured rates
+  std::string model;        ///< of the prediction
+  DriftHarmonics measured_harmonics, predicted_harmonics, residual_harmonics;
+  double rms_difference_rad_s = 0.0;  ///< RMS over bins of measured - predicted
+  double rms_measured_rad_s = 0.0;    ///< RMS over bins of the measured drift (uncompensated)
+  int bins_measured = 0;
+  std::string summary;
+};
+
+/// InputError when the record is too short or theta does not cover at least 3/4 of a period.
+DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
+                             const UncertainParameters& params, int n_bins = 24,
+                             double confidence = 0.95);
+
+}  // namespace cvg_bench
