@@ -183,6 +183,10 @@ ParameterFile readParameterFile(const std::string& path) {
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path + ": not valid JSON (" + e.what() + ")");
   }
+  return parameterFileFromJson(std::move(j), path);
+}
+
+ParameterFile parameterFileFromJson(nlohmann::json j, const std::string& path) {
   ParameterFile f;
   // explain --json: the selected model's estimate is its "final" member (interfaces.md).
   if (j.is_object() && !j.contains("parameters") && j.contains("final") && j["final"].is_object()) {

@@ -12,6 +12,7 @@
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/package_resources.h"
 #include "cvg_ident_commands.h"
+#include "fleet_drift.h"
 #include "fleet_table.h"
 #include "json_fields.h"
 
@@ -179,7 +180,7 @@ int merge(const BatchArgs& a, const std::string& out) {
   for (auto& kv : by_index) entries.push_back(std::move(kv.second));
   std::vector<size_t> expected(record_count);
   for (size_t i = 0; i < record_count; ++i) expected[i] = i;
-  writeFleetTable(entries, record_count, expected, out, "fleet");
+  writeFleetTable(entries, record_count, expected, out, "fleet", addPredictedDrift);
   const size_t missing = record_count - entries.size();
   std::cerr << "batch --merge: " << entries.size() << " of " << record_count << " records from "
             << dirs.size() << " folder(s) -> " << out << "/fleet.csv"
@@ -277,7 +278,7 @@ int runBatch(const std::vector<std::string>& argv) {
                                            : "fleet";
   std::vector<size_t> expected;
   for (const auto& j : jobs) expected.push_back(j.record.index);
-  writeFleetTable(entries, records.size(), expected, out, stem);
+  writeFleetTable(entries, records.size(), expected, out, stem, addPredictedDrift);
   size_t failed = 0;
   for (const auto& e : entries) failed += intField(e.status, "exit_status", 1) != 0;
   std::cerr << "batch: " << entries.size() << " records in " << out << "/" << stem << ".csv ("

@@ -84,7 +84,7 @@ void flatten(const ojson& row, std::vector<std::pair<std::string, ojson>>& out) 
 
 }  // namespace
 
-ojson fleetRow(const FleetEntry& e) {
+ojson fleetRow(const FleetEntry& e, const FleetRowExtension& extend) {
   ojson row;
   row["record"] = stringField(e.status, "record");
   row["input"] = stringField(e.status, "input");
@@ -110,6 +110,7 @@ ojson fleetRow(const FleetEntry& e) {
     row["frequency_hz"] = est["frequency_hz"];
   else if (est.contains("omega") && est["omega"].is_number())
     row["frequency_hz"] = est["omega"].get<double>() / (2 * M_PI);
+  if (extend) extend(e.result, row);
   if (est.contains("derived_ci") && est["derived_ci"].is_object())
     for (auto it = est["derived_ci"].begin(); it != est["derived_ci"].end(); ++it) {
       if (!it->is_object() || !it->contains("value")) continue;
@@ -123,7 +124,7 @@ ojson fleetRow(const FleetEntry& e) {
 
 void writeFleetTable(std::vector<FleetEntry> entries, size_t record_count,
                      const std::vector<size_t>& expected, const std::string& dir,
-                     const std::string& stem) {
+                     const std::string& stem, const FleetRowExtension& extend) {
   std::sort(entries.begin(), entries.end(), [](const FleetEntry& a, const FleetEntry& b) {
     return intField(a.status, "index", 0) < intField(b.status, "index", 0);
   });
@@ -134,7 +135,7 @@ void writeFleetTable(std::vector<FleetEntry> entries, size_t record_count,
   std::set<size_t> present;
   size_t failed = 0;
   for (const auto& e : entries) {
-    const ojson row = fleetRow(e);
+    const ojson row = fleetRow(e, extend);
     records.push_back(row);
     present.insert(static_cast<size_t>(intField(e.status, "index", 0)));
     if (row["exit_status"] != 0) ++failed;

@@ -260,6 +260,24 @@ class BatchExplainTwoMode(unittest.TestCase):
                 self.assertTrue(os.path.isdir(os.path.join(o, "records", r["record"] + "_report")))
             # The hidden cubic stiffness of fd6 is found (as by a single explain call).
             self.assertIn("xi", rows[1]["model"].split("+"))
+            # Drift harmonics per record, the same as `drift` of the record's JSON at r = 1, k = 0:
+            # harmonics of its theta grid by least squares.
+            import numpy as np
+            for r in rows:
+                dj = os.path.join(tmp, r["record"] + "_drift.json")
+                run(["drift", "--params", os.path.join(o, "records", r["json"]), "--r", "1", "--k", "0",
+                     "--theta-grid", "36", "--json", dj], check=0)
+                with open(dj) as f:
+                    grid = json.load(f)["drift"]
+                th = np.array([g["theta_rad"] for g in grid])
+                th = np.remainder(th + np.pi / 4, np.pi / 2) - np.pi / 4
+                y = np.array([g["drift_deg_h"] for g in grid])
+                a = np.column_stack([np.ones_like(th), np.cos(4 * th), np.sin(4 * th), np.cos(8 * th), np.sin(8 * th)])
+                c = np.linalg.lstsq(a, y, rcond=None)[0]
+                self.assertAlmostEqual(float(r["drift_c0_deg_h"]), c[0], delta=1e-6 * abs(c[0]) + 1e-6)
+                self.assertAlmostEqual(float(r["drift_4theta_deg_h"]), np.hypot(c[1], c[2]),
+                                       delta=1e-6 * np.hypot(c[1], c[2]) + 1e-6)
+                self.assertLess(float(r["drift_4theta_deg_h_ci_low"]), float(r["drift_4theta_deg_h"]))
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
 

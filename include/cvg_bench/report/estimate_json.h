@@ -29,6 +29,8 @@ struct ParameterFile {
   std::map<std::string, ParameterEstimate> derived_ci;
 };
 ParameterFile readParameterFile(const std::string& path);
+/// The same from parsed JSON (`path` names it in errors).
+ParameterFile parameterFileFromJson(nlohmann::json j, const std::string& path);
 
 /// Writes JSON to path ("-" = stdout), pretty-printed; throws InputError if it cannot be written.
 void writeJsonFile(const nlohmann::json& j, const std::string& path);

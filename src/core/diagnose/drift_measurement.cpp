@@ -21,7 +21,9 @@ double median(std::vector<double> v) {
   return v[m];
 }
 
-DriftHarmonics harmonics(const std::vector<double>& theta, const std::vector<double>& y) {
+}  // namespace
+
+DriftHarmonics fitDriftHarmonics(const std::vector<double>& theta, const std::vector<double>& y) {
   DriftHarmonics h;
   const int n = static_cast<int>(theta.size());
   if (n < 5) return h;
@@ -43,8 +45,6 @@ DriftHarmonics harmonics(const std::vector<double>& theta, const std::vector<dou
   h.b8 = x(4);
   return h;
 }
-
-}  // namespace
 
 DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
                              const UncertainParameters& params, int n_bins, double confidence) {
@@ -157,9 +157,9 @@ DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
   }
   out.rms_difference_rad_s = std::sqrt(s_d / diff.size());
   out.rms_measured_rad_s = std::sqrt(s_m / meas.size());
-  out.measured_harmonics = harmonics(centres, meas);
-  out.predicted_harmonics = harmonics(centres, pred);
-  out.residual_harmonics = harmonics(centres, diff);
+  out.measured_harmonics = fitDriftHarmonics(centres, meas);
+  out.predicted_harmonics = fitDriftHarmonics(centres, pred);
+  out.residual_harmonics = fitDriftHarmonics(centres, diff);
   const double dh = 180.0 / M_PI * 3600.0;
   std::ostringstream s;
   s.precision(4);
@@ -171,6 +171,40 @@ DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
     << (out.rms_difference_rad_s > 0 ? out.rms_measured_rad_s / out.rms_difference_rad_s : 0.0)
     << "x less";
   out.summary = s.str();
+  return out;
+}
+
+}  // namespace cvg_bench
+
+namespace cvg_bench {
+
+PredictedDriftHarmonics predictDriftHarmonics(const UncertainParameters& params, double r,
+                                              double k) {
+  PredictedDriftHarmonics out;
+  const ResonatorModel model = freeOscillationModelOf(params.values);
+  out.model = model.spec();
+  constexpr int kGrid = 36;
+  std::vector<double> theta(kGrid);
+  for (int i = 0; i < kGrid; ++i) theta[i] = -M_PI / 4 + (i + 0.5) * (M_PI / 2) / kGrid;
+  auto harmonicsAt = [&](const ParameterValues& v) {
+    std::vector<double> y(kGrid);
+    for (int i = 0; i < kGrid; ++i)
+      y[i] = orbitRatesOfModel(model, v, OrbitElements{r, k, theta[i], 0.0}).theta_dot;
+    return fitDriftHarmonics(theta, y);
+  };
+  out.c0 = deltaMethod([&](const ParameterValues& v) { return harmonicsAt(v).c0; }, params);
+  out.amp4 = deltaMethod(
+      [&](const ParameterValues& v) {
+        const DriftHarmonics h = harmonicsAt(v);
+        return std::hypot(h.a4, h.b4);
+      },
+      params);
+  out.amp8 = deltaMethod(
+      [&](const ParameterValues& v) {
+        const DriftHarmonics h = harmonicsAt(v);
+        return std::hypot(h.a8, h.b8);
+      },
+      params);
   return out;
 }
 

@@ -47,6 +47,20 @@ struct DriftComparison {
   std::string summary;
 };
 
+/// Least squares of c0 + a4 cos 4 theta + b4 sin 4 theta + a8 cos 8 theta + b8 sin 8 theta.
+DriftHarmonics fitDriftHarmonics(const std::vector<double>& theta_rad,
+                                 const std::vector<double>& y);
+
+/// The predicted drift's harmonics over one period of theta at (r, k), each with its delta-method
+/// interval: the constant c0, and the amplitudes of the 4 theta and 8 theta harmonics [rad/s]
+/// (e.g. one row of a fleet table: what each resonator's identified model predicts).
+struct PredictedDriftHarmonics {
+  ParameterEstimate c0, amp4, amp8;
+  std::string model;
+};
+PredictedDriftHarmonics predictDriftHarmonics(const UncertainParameters& params, double r,
+                                              double k);
+
 /// InputError when the record is too short or theta does not cover at least 3/4 of a period.
 DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
                              const UncertainParameters& params, int n_bins = 24,
