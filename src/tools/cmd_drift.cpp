@@ -97,6 +97,7 @@ int runMeasuredDrift(const CliArgs& args, const UncertainParameters& up) {
     if (it != any.slow.metadata.end()) walk = std::strtod(it->second.c_str(), nullptr);
   }
   const long bins = args.getInt("bins", 24);
+  if (bins < 4 || bins > 3600) throw InputError("--bins: need 4..3600 theta bins");
   const DriftComparison c = measureDrift(any.slow, walk, up, static_cast<int>(bins), up.confidence);
   const double dh = 180.0 / M_PI * 3600.0;
   nlohmann::json j;
