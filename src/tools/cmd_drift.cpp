@@ -3,6 +3,7 @@
 // file).
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 
@@ -11,10 +12,12 @@
 #include "cvg_bench/core/diagnose/drift_measurement.h"
 #include "cvg_bench/core/estimate/derived_quantities.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"
+#include "cvg_bench/core/model/package_resources.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
 
@@ -29,6 +32,7 @@ namespace {
 const char* kHelp =
     "usage: cvg_ident drift --params FILE.json [--r R --k K --theta TH | --theta-grid N]\n"
     "       cvg_ident drift --params FILE.json --measured RECORD [--walk RAD_S] [--bins N]\n"
+    "                       [--png FILE]\n"
     "                       [--angular-gain K] [--json FILE]\n"
     "Drift rate theta' of (5.9) [rad/s and deg/h] of the wave pattern at amplitude r, quadrature "
     "k\n"
@@ -44,7 +48,8 @@ const char* kHelp =
     "whole_angle; the walk from its # whole_angle_walk_rad_s line or --walk) in --bins theta bins\n"
     "(default 24) beside the model's prediction; harmonics, RMS difference and the residual drift\n"
     "after compensation with the prediction (JSON theta_deg, measured_deg_h, measured_ci,\n"
-    "predicted_deg_h, predicted_ci, harmonics, rms_difference_deg_h, ...).\n"
+    "predicted_deg_h, predicted_ci, harmonics, rms_difference_deg_h, ...); --png: the plot of\n"
+    "both with their bands and the residual after compensation.\n"
     "example: cvg_ident drift --params est.json --r 0.5 --k 0.1 --theta 0.3\n";
 
 /// The amplitude envelope's decay at one state, from (5.7): rate = -2 r'/r [1/s] and the quality
@@ -159,13 +164,30 @@ int runMeasuredDrift(const CliArgs& args, const UncertainParameters& up) {
       "subtracted, mean of passes with a Student-t interval (one pass: HAC); predicted: theta' of "
       "the model by the chain rule at the run's median r, k, delta-method interval";
   if (args.has("json")) writeJsonFile(j, args.get("json"));
+  if (args.has("png")) {
+    // The angle-dependent drift plot (scripts/drift_plot.py) from this JSON.
+    const std::string png = args.get("png");
+    requireOutputFile(png, "--png");
+    const std::string json_path = png + ".json";
+    writeJsonFile(j, json_path);
+    std::string script = executableDirectory() + "/drift_plot.py";
+    if (!std::filesystem::is_regular_file(script))
+      script = findPackageResource("scripts/drift_plot.py");
+    const std::string cmd = "/usr/bin/python3 '" + script + "' '" + json_path + "' '" + png + "'";
+    const int rc = std::system(cmd.c_str());
+    std::filesystem::remove(json_path);
+    if (rc != 0)
+      std::cerr << "cvg_ident drift: the plot was not made (" << cmd << ")\n";
+    else
+      std::cout << "plot: " << png << "\n";
+  }
   return 0;
 }
 
 int runDrift(const std::vector<std::string>& argv) {
   const CliArgs args(argv,
                      {"params", "r", "k", "theta", "theta-grid", "json", "angular-gain", "measured",
-                      "walk", "bins"},
+                      "walk", "bins", "png"},
                      {});
   if (args.help()) {
     std::cout << kHelp;

@@ -74,6 +74,9 @@ class WholeAngleDrift(unittest.TestCase):
         run(["simulate", "--preset", "quartz_cylinder", "--mode", "free_decay", "--seed", "5", "--out", fd])
         run(["identify", fd, "--mode", "free_decay", "--model", "xi", "--json", est], ok=(0, 1))
         j = self.measured(est, "est_drift.json")
+        png = os.path.join(self.tmp.name, "drift.png")
+        run(["drift", "--params", est, "--measured", self.wa, "--png", png])
+        self.assertGreater(os.path.getsize(png), 10000)
         # Identification from a free decay predicts the whole-angle drift: most of it is removed.
         self.assertGreater(j["compensation_gain"], 3.0, j["rms_difference_deg_h"])
         self.assertLess(j["residual_after_compensation_deg_h"], j["rms_measured_deg_h"] / 3.0)
