@@ -26,3 +26,6 @@ if [ -f scripts/validation/validate_response.py ]; then
   /usr/bin/python3 scripts/validation/validate_response.py --n 30 --jobs "${VALIDATE_JOBS:-2}" \
     --markdown docs/validation_response_tables.md
 fi
+if [ -f scripts/validation/validate_drift.py ]; then
+  /usr/bin/python3 scripts/validation/validate_drift.py --out build/validate_drift
+fi

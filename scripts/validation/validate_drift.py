@@ -1,0 +1,166 @@
+#!/usr/bin/python3
+"""Drift validation (issue #26 item 4, docs/validation_drift.md): identify -> predict -> measure ->
+compensate, for each preset and the terms that move the pattern at the whole-angle run's state.
+
+Per case: `simulate --mode free_decay` with the case's effects, `identify` with the resonator's
+terms (or, for a "missed" case, without the case's term), `simulate --mode whole_angle` of the same
+resonator (seed differs), `drift --params EST --measured RUN --png`. Reported: the fraction of theta
+bins whose measured drift lies in the prediction's band (target >= 0.9) and the compensation gain
+RMS(measured) / RMS(measured - predicted) (target >= 10 where the drift is large against the noise).
+A model that leaves out a term the resonator has must visibly fail (band fraction or gain).
+
+Thresholds fixed before the run: band >= 0.9, gain >= 10; "large against the noise" = the measured
+RMS drift above 20x the median measured interval half-width.
+With k held at 0 (ideal loops), theta' is moved by the linear terms (nu, b) and xi_diff only; xi,
+kappa and xi_k act through r k (orbit_rates_chain_rule_test.cpp declares each term's effect).
+
+usage: validate_drift.py [--out DIR] [--markdown FILE] [--seed N]
+"""
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+TOOL = os.path.join(ROOT, "bin", "cvg_ident")
+PRESETS = ["mems_ring", "hrg_hemispherical", "quartz_cylinder"]
+
+
+def arg(name, default):
+    return type(default)(sys.argv[sys.argv.index(name) + 1]) if name in sys.argv else default
+
+
+def run(args):
+    p = subprocess.run([TOOL] + args, capture_output=True, text=True, timeout=1800)
+    return p.returncode, p.stdout, p.stderr
+
+
+def header(path):
+    h = {}
+    with open(path) as f:
+        for line in f:
+            if not line.startswith("#"):
+                break
+            k, _, v = line[1:].partition(":")
+            h[k.strip()] = v.strip()
+    return h
+
+
+def drift_scale(truth, r0):
+    """A size for xi_diff whose theta' is about twice the damping anisotropy's at r0."""
+    bm = math.hypot(truth.get("b_c", 0.0), truth.get("b_s", 0.0))
+    return max(2.0 * bm, 1e-4) / (r0 * r0)
+
+
+def case_list(preset, truth, r0):
+    base_terms = [t for t in truth.get("model", "linear").split("+") if t != "linear"]
+    v = drift_scale(truth, r0)
+    both = "gamma_nl=%g" % (0.5 * abs(truth.get("gamma", 0.01)) / (r0 * r0))
+    return [
+        ("resonator as shipped", [], base_terms),
+        ("+ xi_diff", ["xi_diff=%g" % v], base_terms + ["xi_diff"]),
+        ("+ xi_diff, identified without it", ["xi_diff=%g" % v], base_terms),
+        ("+ xi_diff + gamma_nl (two at once)", ["xi_diff=%g" % v, both], base_terms + ["xi_diff", "gamma_nl"]),
+    ]
+
+
+def one(preset, label, effects, terms, work, seed):
+    tag = preset + "_" + "".join(c if c.isalnum() else "_" for c in label)
+    fx = []
+    for e in effects:
+        fx += ["--effect", e]
+    fd = os.path.join(work, tag + "_fd.csv")
+    wa = os.path.join(work, tag + "_wa.csv")
+    est = os.path.join(work, tag + "_est.json")
+    out = os.path.join(work, tag + "_drift.json")
+    png = os.path.join(work, tag + "_drift.png")
+    rc, _, err = run(["simulate", "--preset", preset, "--mode", "free_decay", "--seed", str(seed), "--out", fd] + fx)
+    if rc != 0:
+        return {"error": "simulate free decay: " + err.strip()[-200:]}
+    model = "+".join(sorted(set(terms), key=terms.index)) if terms else "linear"
+    rc, _, err = run(["identify", fd, "--mode", "free_decay", "--model", model, "--json", est])
+    if rc not in (0, 1) or not os.path.exists(est):
+        return {"error": "identify: " + err.strip()[-200:]}
+    # The walk: 4x the largest true drift over theta (slower, and the pattern would lock where the
+    # drift cancels the walk), over 1.5 periods of theta.
+    h = header(fd)
+    truth = {k[len("truth_"):]: float(v) for k, v in h.items() if k.startswith("truth_") and k != "truth_model"}
+    tj = os.path.join(work, tag + "_truth.json")
+    with open(tj, "w") as f:
+        json.dump({"omega": float(h["omega"]), "parameters": truth}, f)
+    gj = os.path.join(work, tag + "_grid.json")
+    rc, _, err = run(["drift", "--params", tj, "--r", "0.5", "--k", "0", "--theta-grid", "36", "--json", gj])
+    if rc != 0:
+        return {"error": "drift grid: " + err.strip()[-200:]}
+    with open(gj) as f:
+        peak = max(abs(g["drift_rad_s"]) for g in json.load(f)["drift"])
+    walk = max(4.0 * peak, 1e-6)
+    duration = 1.5 * (math.pi / 2) / walk
+    rc, _, err = run(["simulate", "--preset", preset, "--mode", "whole_angle", "--seed", str(seed + 1),
+                      "--walk", repr(walk), "--duration", repr(duration), "--out", wa] + fx)
+    if rc != 0:
+        return {"error": "simulate whole_angle: " + err.strip()[-200:]}
+    rc, _, err = run(["drift", "--params", est, "--measured", wa, "--json", out, "--png", png])
+    if rc != 0:
+        return {"error": "drift --measured: " + err.strip()[-300:], "model": model}
+    with open(out) as f:
+        j = json.load(f)
+    inside = total = 0
+    halfwidths = []
+    for m, mci, pci in zip(j["measured_deg_h"], j["measured_ci"], j["predicted_ci"]):
+        if m is None:
+            continue
+        total += 1
+        inside += pci[0] <= m <= pci[1]
+        halfwidths.append(0.5 * (mci[1] - mci[0]))
+    large = j["rms_measured_deg_h"] > 20 * statistics.median(halfwidths)
+    band = inside / total if total else 0.0
+    gain = j["compensation_gain"] or 0.0
+    return {"model": model, "band": band, "bins": total, "gain": gain, "large": large,
+            "rms_measured": j["rms_measured_deg_h"], "rms_after": j["residual_after_compensation_deg_h"],
+            "png": png, "pass": band >= 0.9 and (gain >= 10 or not large)}
+
+
+def main():
+    seed = arg("--seed", 4100)
+    work = arg("--out", os.path.join(ROOT, "build", "validate_drift"))
+    md = arg("--markdown", "")
+    os.makedirs(work, exist_ok=True)
+    rows = []
+    r0 = 0.5
+    for preset in PRESETS:
+        probe = os.path.join(work, preset + "_probe.csv")
+        run(["simulate", "--preset", preset, "--mode", "free_decay", "--seed", "1", "--out", probe])
+        h = header(probe)
+        truth = {k[len("truth_"):]: float(v) for k, v in h.items() if k.startswith("truth_") and k != "truth_model"}
+        truth["model"] = h.get("truth_model", "linear")
+        for label, effects, terms in case_list(preset, truth, r0):
+            res = one(preset, label, effects, terms, work, seed)
+            res.update({"preset": preset, "case": label, "effects": effects})
+            rows.append(res)
+            print(json.dumps(res), flush=True)
+    lines = ["| preset | case | model identified | bins in band | gain | RMS drift -> after [deg/h] | verdict |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if "error" in r:
+            lines.append("| %s | %s | %s | - | - | - | error: %s |" % (r["preset"], r["case"], r.get("model", ""),
+                                                                   r["error"].replace("|", "/")))
+            continue
+        expect_fail = "without" in r["case"]
+        verdict = ("fails, as it must" if not r["pass"] else "PASSES (should fail)") if expect_fail else \
+            ("pass" if r["pass"] else "FAIL")
+        lines.append("| %s | %s | %s | %.2f of %d | %.1f | %.3g -> %.3g | %s |" % (
+            r["preset"], r["case"], r["model"], r["band"], r["bins"], r["gain"], r["rms_measured"], r["rms_after"],
+            verdict))
+    table = "\n".join(lines)
+    print(table)
+    if md:
+        with open(md, "w") as f:
+            f.write("<!-- written by scripts/validation/validate_drift.py --seed %d -->\n%s\n" % (seed, table))
+
+
+if __name__ == "__main__":
+    main()
