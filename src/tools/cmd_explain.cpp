@@ -127,6 +127,11 @@ int runExplain(const std::vector<std::string>& argv) {
     slow = rec.kind == RecordKind::kRaw ? demodulateRawRecord(rec.raw, id.omega_rad_s, input_notes)
                                         : rec.slow;
     if (!(id.omega_rad_s > 0.0) && slow.omega_rad_s > 0.0) id.omega_rad_s = slow.omega_rad_s;
+    // Without omega the final model could not be used downstream (drift, Q): refused (#25).
+    if (!(id.omega_rad_s > 0.0))
+      throw InputError(input +
+                       ": the natural frequency omega is unknown (no '# omega:' line): give "
+                       "--omega W [rad/s]; without it the model's Q and drift cannot be computed");
     x = explainFreeDecay(slow, options);
   } else {
     if (rec.kind != RecordKind::kForcedSweep)

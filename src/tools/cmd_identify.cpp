@@ -51,6 +51,15 @@ const char* kHelp =
     "Exit 1 when the data cannot identify every parameter (the report says which and why).\n"
     "example: cvg_ident identify sweep.csv --mode forced --model xi+mu --method ceres\n";
 
+/// A free-decay model without the natural frequency cannot be used downstream (drift, Q): refused
+/// before fitting (issue #25: never a model with omega 0 at exit 0).
+void requireKnownOmega(double option, const SlowRecord& rec) {
+  if (!(option > 0.0) && !(rec.omega_rad_s > 0.0))
+    throw InputError(rec.source +
+                     ": the natural frequency omega is unknown (no '# omega:' line): give --omega "
+                     "W [rad/s]; without it the model's Q and drift cannot be computed");
+}
+
 void printTable(const Estimate& e, std::ostream& os) {
   os << "mode " << experimentModeName(e.mode) << ", model " << e.model << ", method " << e.method
      << ", omega " << e.omega_rad_s << " rad/s\n"
@@ -136,6 +145,7 @@ int runIdentify(const std::vector<std::string>& argv) {
                          ? demodulateRawRecord(any.raw, opt.omega_rad_s, pre_notes)
                          : any.slow;
     if (rec.source.empty()) rec.source = path;
+    requireKnownOmega(opt.omega_rad_s, rec);
     e = identify(rec, po);
   } else {
     if (any.kind == RecordKind::kFreeDecay)

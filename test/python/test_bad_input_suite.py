@@ -643,6 +643,20 @@ class BadInputSuite(unittest.TestCase):
             # mu needs --method ceres (exit 2 with LS); cm_rate is free decay only.
             self.check("forced --model %r (ls)" % m, sweep + [m], "bad")
 
+    def test_free_decay_without_omega(self):
+        """A slow record without '# omega:' (and no --omega) is refused by identify and explain:
+        their model could not be used downstream (issue #25); with --omega it runs."""
+        with open(self.slow_path) as f:
+            text = "".join(line for line in f if "omega" not in line)
+        path = self.write(text)
+        for cmd in (["identify", path, "--mode", "free_decay", "--model", "linear"],
+                    ["explain", path, "--mode", "free_decay"]):
+            self.check(cmd[0] + " without omega", cmd, "bad", names=(path, "--omega"))
+        with open(self.slow_path) as f:
+            omega = next(line.split(":")[1].strip() for line in f if line.startswith("# omega:"))
+        self.check("identify with --omega", ["identify", path, "--mode", "free_decay", "--model", "linear",
+                                             "--omega", omega], "ok")
+
     def test_mu_models_run_under_ceres(self):
         for m in ["mu", "xi+mu"]:
             js = self.out()
