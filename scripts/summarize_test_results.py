@@ -22,7 +22,12 @@ def count(path):
             continue
         if bad:
             failed += 1
-            names.append("%s.%s" % (case.get("classname"), case.get("name")))
+            # The failure's own message (first lines), so that a CI log says why, not only what.
+            why = case.find("failure") if case.find("failure") is not None else case.find("error")
+            text = " ".join(filter(None, [why.get("message"), why.text]))
+            lines = [l for l in text.strip().splitlines() if l.strip()][-6:]
+            names.append("%s.%s%s" % (case.get("classname"), case.get("name"),
+                                      "".join("\n    " + l[:300] for l in lines)))
         else:
             passed += 1
     return passed, failed, names

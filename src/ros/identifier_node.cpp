@@ -111,6 +111,7 @@ void IdentifierNode::clearBuffer() {
   sweep_ = SweepRecord();
   have_latest_ = false;
   new_data_since_identify_ = false;
+  lost_in_buffer_ = 0;
   if (rls_) rls_->reset();
   rls_origin_ = ros::Time();
 }
@@ -175,7 +176,10 @@ void IdentifierNode::countSequence(uint32_t seq) {
   ++received_;
   // Publishers number their messages; a skipped number is a message lost on the way (a full
   // subscriber queue). A number going back is a restarted publisher or a looped bag.
-  if (have_seq_ && seq > last_seq_) dropped_transport_ += seq - last_seq_ - 1;
+  if (have_seq_ && seq > last_seq_) {
+    dropped_transport_ += seq - last_seq_ - 1;
+    lost_in_buffer_ += seq - last_seq_ - 1;
+  }
   have_seq_ = true;
   last_seq_ = seq;
 }
@@ -387,6 +391,9 @@ void IdentifierNode::publishEstimate() {
   msg.experiment_id = buffer_experiment_;
   msg.experiment_start = buffer_experiment_start_;
   msg.sanity_problems = sanityProblems(estimate_);
+  if (lost_in_buffer_ > 0)
+    msg.sanity_problems.push_back(std::to_string(lost_in_buffer_) +
+                                  " input messages lost in transport (sequence gaps) since these data began");
   msg.suspect = !msg.sanity_problems.empty();
   if (msg.suspect) {
     ++suspect_estimates_;

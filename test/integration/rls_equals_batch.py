@@ -22,9 +22,11 @@ class RlsEqualsBatch(unittest.TestCase):
         with rosbag.Bag(bag) as b:
             n = b.get_message_count("/cvg/slow")
         got = {}
+        seen = {}  # method -> most samples seen, for the failure message
         done = threading.Event()
 
         def on_estimate(msg):
+            seen[msg.method] = max(seen.get(msg.method, 0), msg.n_samples)
             if msg.n_samples == n:
                 got.setdefault(msg.method, msg)
             if "rls" in got and "ls" in got:
@@ -40,8 +42,8 @@ class RlsEqualsBatch(unittest.TestCase):
             finished = done.wait(timeout)
         finally:
             player.stop()
-        self.assertTrue(finished, "got %s within %g s, need rls and ls over %d states" %
-                        (sorted(got), timeout, n))
+        self.assertTrue(finished, "got %s within %g s, need rls and ls over %d states; most "
+                        "samples seen per method: %s" % (sorted(got), timeout, n, seen))
         rls, ls = got["rls"], got["ls"]
         self.assertEqual(rls.names, ls.names)
         self.assertEqual(rls.n_equations, ls.n_equations)

@@ -116,6 +116,9 @@ class IdentifierNode {
   ros::WallTime last_diag_wall_;
   uint64_t dropped_invalid_ = 0, dropped_duplicate_ = 0, dropped_transport_ = 0, trimmed_ = 0;
   bool have_seq_ = false;
+  // Messages lost in transport (sequence gaps) since the buffer was last cleared: every estimate
+  // over these data is published suspect with the count (issue #27).
+  uint64_t lost_in_buffer_ = 0;
   uint32_t last_seq_ = 0;
   uint64_t identifications_ = 0, identification_failures_ = 0, suspect_estimates_ = 0;
   double last_identify_wall_s_ = 0.0;
