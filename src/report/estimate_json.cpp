@@ -1,5 +1,6 @@
 #include "cvg_bench/report/estimate_json.h"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -161,6 +162,27 @@ void readCovariance(const nlohmann::json& c, const std::string& path, ParameterF
                          f->cov_names[col] + " exceeds the product of their standard deviations");
     }
   }
+  // Pairwise bounds do not make a matrix a covariance: its correlation matrix (over the entries
+  // with a positive variance) must have no negative eigenvalue beyond rounding.
+  std::vector<Eigen::Index> kept;
+  for (size_t r = 0; r < n; ++r)
+    if (f->covariance(r, r) > 0.0) kept.push_back(static_cast<Eigen::Index>(r));
+  if (kept.size() > 1) {
+    Eigen::MatrixXd corr(kept.size(), kept.size());
+    for (size_t a = 0; a < kept.size(); ++a)
+      for (size_t b = 0; b < kept.size(); ++b)
+        corr(a, b) = 0.5 * (f->covariance(kept[a], kept[b]) + f->covariance(kept[b], kept[a])) /
+                     std::sqrt(f->covariance(kept[a], kept[a]) * f->covariance(kept[b], kept[b]));
+    const double smallest =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(corr, Eigen::EigenvaluesOnly)
+            .eigenvalues()
+            .minCoeff();
+    if (smallest < -1e-8)
+      throw InputError(path +
+                       ": covariance.matrix is not positive semi-definite (its correlation "
+                       "matrix has the eigenvalue " +
+                       std::to_string(smallest) + ")");
+  }
 }
 
 int readDof(const nlohmann::json& j, const char* key, const std::string& path) {
@@ -248,6 +270,16 @@ ParameterFile parameterFileFromJson(nlohmann::json j, const std::string& path) {
       f.derived_ci[kv.key()] = pe;
     }
   return f;
+}
+
+UncertainParameters uncertainParameters(const ParameterFile& pf) {
+  UncertainParameters up;
+  up.values = pf.values;
+  up.cov_names = pf.cov_names;
+  up.covariance = pf.covariance;
+  up.dof = pf.dof;
+  up.confidence = pf.confidence;
+  return up;
 }
 
 void writeJsonFile(const nlohmann::json& j, const std::string& path) {

@@ -392,8 +392,9 @@ void IdentifierNode::publishEstimate() {
   msg.experiment_start = buffer_experiment_start_;
   msg.sanity_problems = sanityProblems(estimate_);
   if (lost_in_buffer_ > 0)
-    msg.sanity_problems.push_back(std::to_string(lost_in_buffer_) +
-                                  " input messages lost in transport (sequence gaps) since these data began");
+    msg.sanity_problems.push_back(
+        std::to_string(lost_in_buffer_) +
+        " input messages lost in transport (sequence gaps) since these data began");
   msg.suspect = !msg.sanity_problems.empty();
   if (msg.suspect) {
     ++suspect_estimates_;

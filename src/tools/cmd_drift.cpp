@@ -211,12 +211,7 @@ int runDrift(const std::vector<std::string>& argv) {
                        " pattern angles, got " + std::to_string(n));
     thetas = thetaGrid(n);
   }
-  UncertainParameters up;
-  up.values = pf.values;
-  up.cov_names = pf.cov_names;
-  up.covariance = pf.covariance;
-  up.dof = pf.dof;
-  up.confidence = pf.confidence;
+  const UncertainParameters up = report::uncertainParameters(pf);
   const bool with_ci = !pf.cov_names.empty();
   if (args.has("measured")) return runMeasuredDrift(args, up);
   // Section 4's figures as identify / explain reported them (each from what the record

@@ -17,13 +17,8 @@ void addPredictedDrift(const nlohmann::json& result, nlohmann::ordered_json& row
       (result.contains("final") && result["final"].is_object() ? result["final"] : result), "mode");
   if (mode != "free_decay" && mode != "forced") return;
   try {
-    const report::ParameterFile pf = report::parameterFileFromJson(result, "record JSON");
-    UncertainParameters up;
-    up.values = pf.values;
-    up.cov_names = pf.cov_names;
-    up.covariance = pf.covariance;
-    up.dof = pf.dof;
-    up.confidence = pf.confidence;
+    const UncertainParameters up =
+        report::uncertainParameters(report::parameterFileFromJson(result, "record JSON"));
     const PredictedDriftHarmonics h = predictDriftHarmonics(up, 1.0, 0.0);
     constexpr double kDegH = 180.0 / M_PI * 3600.0;
     auto put = [&](const char* name, const ParameterEstimate& p) {

@@ -745,8 +745,16 @@ class BadInputSuite(unittest.TestCase):
 
         def set_cov(r, c, v):
             return lambda j: j["covariance"]["matrix"][r].__setitem__(c, v)
+        def not_psd(j):
+            # Every pair within the Cauchy-Schwarz bound, the three together not a covariance
+            # (correlations 0.9, 0.9, -0.9: eigenvalue -0.8).
+            m = j["covariance"]["matrix"]
+            d = [m[i][i] for i in range(3)]
+            for a, b, rho in ((0, 1, 0.9), (0, 2, 0.9), (1, 2, -0.9)):
+                m[a][b] = m[b][a] = rho * (d[a] * d[b]) ** 0.5
         cases = [
             ("not json", "{", ()),
+            ("covariance not positive semi-definite", variant(not_psd), ("semi-definite",)),
             ("empty", "", ()),
             ("array", "[1, 2]", ("parameters",)),
             ("NaN literal", json.dumps(base).replace(str(base["omega"]), "NaN", 1), ()),

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "cvg_bench/core/estimate/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/estimate.h"
 #include "cvg_bench/core/model/resonator_model.h"
 
@@ -31,6 +32,9 @@ struct ParameterFile {
 ParameterFile readParameterFile(const std::string& path);
 /// The same from parsed JSON (`path` names it in errors).
 ParameterFile parameterFileFromJson(nlohmann::json j, const std::string& path);
+
+/// The file's values with their covariance, as the delta-method functions take them.
+UncertainParameters uncertainParameters(const ParameterFile& pf);
 
 /// Writes JSON to path ("-" = stdout), pretty-printed; throws InputError if it cannot be written.
 void writeJsonFile(const nlohmann::json& j, const std::string& path);

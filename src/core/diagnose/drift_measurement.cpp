@@ -10,15 +10,14 @@
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"
+#include "cvg_bench/core/model/sample_median.h"
 
 namespace cvg_bench {
 
 namespace {
 
-double median(std::vector<double> v) {
-  const size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
+double median(const std::vector<double>& v) {
+  return sampleMedian(v);
 }
 
 }  // namespace

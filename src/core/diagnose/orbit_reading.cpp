@@ -8,6 +8,7 @@
 #include "cvg_bench/core/estimate/internal/hac_slope.h"
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/orbit_elements.h"
+#include "cvg_bench/core/model/sample_median.h"
 
 namespace cvg_bench {
 
@@ -15,11 +16,8 @@ namespace {
 
 constexpr double kDegPerHour = 180.0 / M_PI * 3600.0;
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
+double median(const std::vector<double>& v) {
+  return sampleMedian(v, 0.0);
 }
 
 /// Mean of window values with a Student-t interval from their scatter.

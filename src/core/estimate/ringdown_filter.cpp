@@ -9,6 +9,7 @@
 
 #include "cvg_bench/core/estimate/ringdown_intervals.h"
 #include "cvg_bench/core/estimate/ringdown_models.h"
+#include "cvg_bench/core/model/sample_median.h"
 
 namespace cvg_bench {
 namespace {
@@ -16,11 +17,8 @@ namespace {
 constexpr double kDbPerNeper = 20.0 / 2.302585092994046;
 constexpr int kMaxOrder = 4;
 
-double median(std::vector<double> v) {
-  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
+double median(const std::vector<double>& v) {
+  return sampleMedian(v);
 }
 
 double factorial(int k) {

@@ -10,6 +10,7 @@
 #include "cvg_bench/core/estimate/ringdown_record_window.h"
 #include "cvg_bench/core/estimate/ringdown_straight_span.h"
 #include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/sample_median.h"
 
 namespace cvg_bench {
 namespace {
@@ -28,11 +29,8 @@ constexpr double kFloorScatter = 0.2;
 /// the first half of the decay before the crossing (the signal's own noise).
 constexpr double kFloorScatterRatio = 2.0;
 
-double median(std::vector<double> v) {
-  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
+double median(const std::vector<double>& v) {
+  return sampleMedian(v);
 }
 
 /// Least-squares slope of y on t over the finite, non-skipped samples of [a, b).

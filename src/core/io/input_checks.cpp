@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/sample_median.h"
 
 namespace cvg_bench {
 namespace {
@@ -21,11 +22,8 @@ std::string fmt(double v) {
   return buf;
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + mid, v.end());
-  return v[mid];
+double median(const std::vector<double>& v) {
+  return sampleMedian(v, 0.0);
 }
 
 }  // namespace
