@@ -1,5 +1,6 @@
 // Reader and writer of one-mode frequency-response files (response_record.h).
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -62,11 +63,74 @@ bool parseNumber(const std::string& field, double& v) {
   return end != field.c_str() && *end == '\0' && errno != ERANGE;
 }
 
-/// A header cell without a bracketed unit: "x [V]" -> "x".
+/// A header cell without a bracketed unit, as a key: "x [V]" -> "x". Instruments' own short
+/// names are read as the keys they mean (t/time, F/freq/frequency, X/Y, D/drive/current/I).
 std::string headerName(const std::string& cell) {
   std::string s = cell.substr(0, cell.find('['));
-  s = s.substr(0, s.find('('));
-  return lowerTrimmed(s);
+  s = lowerTrimmed(s.substr(0, s.find('(')));
+  static const std::map<std::string, std::string> kAliases = {{"time", "t"},
+                                                              {"time_s", "t"},
+                                                              {"f", "frequency_hz"},
+                                                              {"freq", "frequency_hz"},
+                                                              {"frequency", "frequency_hz"},
+                                                              {"f_hz", "frequency_hz"},
+                                                              {"d", "drive"},
+                                                              {"current", "drive"},
+                                                              {"i", "drive"},
+                                                              {"excitation", "drive"},
+                                                              {"dir", "direction"}};
+  const auto it = kAliases.find(s);
+  return it == kAliases.end() ? s : it->second;
+}
+
+/// Four headerless columns: t, F, X, Y (one drive level) when the first column never decreases
+/// (a clock) while the second turns round (sweeps); F, X, Y, drive when the fourth is positive
+/// and takes at most one distinct value per 5 rows (set drive levels). Else nothing is guessed.
+std::map<std::string, int> guessFourColumns(const std::string& text, std::string* note) {
+  std::istringstream in(text);
+  std::string line;
+  std::vector<std::array<double, 4>> rows;
+  while (std::getline(in, line) && rows.size() < 100000) {
+    const std::string t = lowerTrimmed(line);
+    if (t.empty() || t[0] == '#' || t[0] == '%') continue;
+    const std::vector<std::string> f = splitRow(line);
+    if (f.size() != 4) return {};
+    std::array<double, 4> r{};
+    for (int i = 0; i < 4; ++i)
+      if (!parseNumber(f[i], r[i]) || !std::isfinite(r[i])) return {};
+    rows.push_back(r);
+  }
+  if (rows.size() < 8) return {};
+  bool first_clock = true, second_turns = false, fourth_positive = true;
+  int prev_sign = 0;
+  std::vector<double> fourth;
+  for (size_t i = 0; i < rows.size(); ++i) {
+    fourth.push_back(rows[i][3]);
+    fourth_positive = fourth_positive && rows[i][3] > 0.0;
+    if (i == 0) continue;
+    first_clock = first_clock && rows[i][0] >= rows[i - 1][0];
+    const double df = rows[i][1] - rows[i - 1][1];
+    const int sign = df > 0 ? 1 : (df < 0 ? -1 : 0);
+    if (sign != 0 && prev_sign != 0 && sign != prev_sign) second_turns = true;
+    if (sign != 0) prev_sign = sign;
+  }
+  if (first_clock && second_turns) {
+    *note =
+        "no header and no --columns: 4 columns read as t, frequency_hz, x, y (the first never "
+        "decreases, the second turns round); one drive level";
+    return {{"t", 0}, {"frequency_hz", 1}, {"x", 2}, {"y", 3}};
+  }
+  std::sort(fourth.begin(), fourth.end());
+  const size_t distinct =
+      static_cast<size_t>(std::unique(fourth.begin(), fourth.end()) - fourth.begin());
+  if (fourth_positive && distinct * 5 <= rows.size()) {
+    *note =
+        "no header and no --columns: 4 columns read as frequency_hz, x, y, drive (the fourth "
+        "holds " +
+        std::to_string(distinct) + " levels)";
+    return {{"frequency_hz", 0}, {"x", 1}, {"y", 2}, {"drive", 3}};
+  }
+  return {};
 }
 
 std::string knownKeys() {
@@ -133,6 +197,8 @@ ResponseRecord readResponseText(const std::string& text, const std::string& sour
   std::string line;
   int line_no = 0;
   bool first_row = true;
+  std::string guess_note;
+  size_t time_ties = 0;
   const std::string where = source + ":";
   while (std::getline(in, line)) {
     ++line_no;
@@ -169,6 +235,8 @@ ResponseRecord readResponseText(const std::string& text, const std::string& sour
           col = {{"t", 0}, {"frequency_hz", 1}, {"x", 2}, {"y", 3}, {"drive", 4}};
           rec.notes.push_back(
               "no header and no --columns: columns read as t, frequency_hz, x, y, drive");
+        } else if (fields.size() == 4 && !(col = guessFourColumns(text, &guess_note)).empty()) {
+          rec.notes.push_back(guess_note);
         } else if (fields.size() == 3) {
           col = {{"frequency_hz", 0}, {"x", 1}, {"y", 2}};
           rec.notes.push_back(
@@ -203,10 +271,13 @@ ResponseRecord readResponseText(const std::string& text, const std::string& sour
       throw InputError(where + std::to_string(line_no) +
                        ": drive must be > 0 (a drive level per point), got " +
                        fields[col.at("drive")]);
-    if (!rec.t_s.empty() && !(tt > rec.t_s.back()))
+    // Equal stamps are a coarse clock (the file's order is the time order); a stamp going back
+    // is two records joined or a wrong column.
+    if (!rec.t_s.empty() && tt < rec.t_s.back())
       throw InputError(where + std::to_string(line_no) +
                        ": time must increase (the file is read in time order), got " +
                        std::to_string(tt) + " after " + std::to_string(rec.t_s.back()));
+    if (!rec.t_s.empty() && tt == rec.t_s.back()) ++time_ties;
     if (col.count("direction")) {
       const int c = col.at("direction");
       double num = 0;
@@ -223,6 +294,10 @@ ResponseRecord readResponseText(const std::string& text, const std::string& sour
     rec.drive.push_back(d);
   }
   rec.has_time = col.count("t") > 0;
+  if (time_ties > 0)
+    rec.notes.push_back(std::to_string(time_ties) +
+                        " points share the time stamp of the point before (a coarse clock); the "
+                        "file's order is taken as the time order");
   if (!col.count("drive") && rec.size() > 0)
     rec.notes.push_back("no drive column: one drive level (1) assumed");
   if (rec.size() < 8)
@@ -247,10 +322,29 @@ void writeResponseCsv(const ResponseRecord& r, std::ostream& out) {
         << r.drive[i] << "\n";
 }
 
+std::vector<int> driveLevels(const std::vector<double>& drive) {
+  std::vector<size_t> order(drive.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return drive[a] < drive[b]; });
+  std::vector<int> level(drive.size(), 0);
+  int current = 0;
+  double first = order.empty() ? 0.0 : drive[order[0]];
+  for (size_t k = 0; k < order.size(); ++k) {
+    const double v = drive[order[k]];
+    if (std::fabs(v - first) > 0.01 * std::fabs(first)) {
+      ++current;
+      first = v;
+    }
+    level[order[k]] = current;
+  }
+  return level;
+}
+
 std::vector<int> splitSweeps(const ResponseRecord& r) {
   const size_t n = r.size();
   std::vector<int> id(n, 0);
   if (n == 0) return id;
+  const std::vector<int> level = driveLevels(r.drive);
   std::vector<double> dt;
   for (size_t i = 1; i < n; ++i) dt.push_back(r.t_s[i] - r.t_s[i - 1]);
   double median_dt = 0;
@@ -263,7 +357,7 @@ std::vector<int> splitSweeps(const ResponseRecord& r) {
   for (size_t i = 1; i < n; ++i) {
     const double df = r.frequency_hz[i] - r.frequency_hz[i - 1];
     const int s = df > 0 ? 1 : (df < 0 ? -1 : 0);
-    bool cut = std::abs(r.drive[i] - r.drive[i - 1]) > 1e-6 * std::abs(r.drive[i - 1]);
+    bool cut = level[i] != level[i - 1];
     cut = cut || (s != 0 && step_sign != 0 && s != step_sign);
     cut = cut || (!r.direction.empty() && r.direction[i] != r.direction[i - 1]);
     cut = cut || (median_dt > 0 && r.t_s[i] - r.t_s[i - 1] > 20.0 * median_dt);

@@ -388,8 +388,19 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   fit.notes.push_back(L.slope ? "background: constant + linear in frequency, per unit drive"
                               : "background: constant per unit drive (a slope was not needed)");
   // Per-drive-level Lorentzians: the nonlinear start and the adequacy reference.
+  // Keyed by the level's mean drive (driveLevels: levels 1 % apart, a measured drive's noise
+  // stays within its level).
   std::map<double, std::vector<int>> by_level;
-  for (size_t i = 0; i < n; ++i) by_level[d.drive[i]].push_back(static_cast<int>(i));
+  {
+    const std::vector<int> level_of = driveLevels(d.drive);
+    std::map<int, std::vector<int>> members;
+    for (size_t i = 0; i < n; ++i) members[level_of[i]].push_back(static_cast<int>(i));
+    for (const auto& kv : members) {
+      double sum = 0.0;
+      for (int i : kv.second) sum += d.drive[i];
+      by_level[sum / static_cast<double>(kv.second.size())] = kv.second;
+    }
+  }
   std::vector<double> free_abs;  // |residual| of the free per-level fits (the noise scale)
   for (const auto& kv : by_level) {
     if (kv.second.size() < 8) continue;
@@ -681,6 +692,11 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
     // between sweeps): 3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations d (= G for
     // Gaussian d of equal variance), at most G - 1.
     fit.interval_dof = std::max(1, used - 1);
+    // The sandwich is a floor only where a fold can trap a refit (a nonlinear term). A linear
+    // model has no fold; there its sandwich, linearised once with unweighted bread under Huber
+    // weights, can exceed the refits' spread many times (the low half of the wire record
+    // example6: width sd 4.7 Hz against leave-one-out deviations of 0.05 Hz) and is not used.
+    const bool folds_possible = L.xi || L.g;
     int min_dof = fit.interval_dof, floored = 0;
     for (auto& kv : reps) {
       const auto& v = kv.second;
@@ -695,7 +711,7 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
           s4 > 0 ? std::max(1, std::min(fit.interval_dof, static_cast<int>(3.0 * ss * ss / s4)))
                  : fit.interval_dof;
       min_dof = std::min(min_dof, dof);
-      if (sandwich_std.count(kv.first) && sandwich_std[kv.first] > sd) {
+      if (folds_possible && sandwich_std.count(kv.first) && sandwich_std[kv.first] > sd) {
         sd = sandwich_std[kv.first];
         ++floored;
       }
@@ -707,8 +723,10 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
                           std::to_string(G) + " refits), Student t with the effective dof " +
                           std::to_string(min_dof) + ".." + std::to_string(fit.interval_dof) +
                           " (3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations); " +
-                          std::to_string(floored) +
-                          " standard errors raised to the within-sweep sandwich's";
+                          (folds_possible ? std::to_string(floored) +
+                                                " standard errors raised to the within-sweep "
+                                                "sandwich's"
+                                          : std::string("no fold, no sandwich floor"));
     if (used < G)
       fit.notes.push_back(std::to_string(G - used) + " jackknife refits did not converge");
   }

@@ -3,6 +3,7 @@
 // field.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <sstream>
 
 #include "cvg_bench/core/io/response_record.h"
@@ -107,6 +108,81 @@ TEST(ResponseReader, BadInputNamesLineAndField) {
   EXPECT_NE(errorOf(zero_drive).find("drive must be > 0"), std::string::npos)
       << errorOf(zero_drive);
   EXPECT_NE(errorOf("# only comments\n").find("at least 8"), std::string::npos);
+}
+
+/// The instrument text with one column left out (0-based index `drop`).
+std::string withoutColumn(const std::string& text, size_t drop) {
+  std::istringstream in(text);
+  std::ostringstream out;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line[0] == '#' || line[0] == '%') continue;
+    std::istringstream cells(line);
+    std::string c;
+    size_t i = 0;
+    std::string row;
+    while (cells >> c)
+      if (i++ != drop) row += (row.empty() ? "" : " ") + c;
+    out << row << "\n";
+  }
+  return out.str();
+}
+
+TEST(ResponseReader, FourHeaderlessColumnsAreReadByWhatTheyHold) {
+  // t, F, X, Y: the first column is a clock, the second turns round.
+  const ResponseRecord a = readResponseText(withoutColumn(instrumentText(' '), 4), "in.txt");
+  ASSERT_EQ(a.size(), 15u);
+  EXPECT_TRUE(a.has_time);
+  EXPECT_DOUBLE_EQ(a.frequency_hz[3], 1633.0);
+  EXPECT_DOUBLE_EQ(a.drive[14], 1.0);
+  EXPECT_NE(a.notes[0].find("t, frequency_hz, x, y"), std::string::npos);
+  // F, X, Y, drive: the fourth holds two levels in 15 rows.
+  const ResponseRecord b = readResponseText(withoutColumn(instrumentText(' '), 0), "in.txt");
+  ASSERT_EQ(b.size(), 15u);
+  EXPECT_FALSE(b.has_time);
+  EXPECT_DOUBLE_EQ(b.frequency_hz[3], 1633.0);
+  EXPECT_DOUBLE_EQ(b.drive[14], 2e-8);
+  EXPECT_NE(b.notes[0].find("2 levels"), std::string::npos);
+  // Neither: nothing is guessed.
+  std::string neither;
+  for (int i = 0; i < 10; ++i)
+    neither += std::to_string(9 - i) + " " + std::to_string(i) + " 1 " + std::to_string(i) + "\n";
+  EXPECT_NE(errorOf(neither).find("give --columns"), std::string::npos);
+}
+
+TEST(ResponseReader, InstrumentHeaderNamesAndCoarseClock) {
+  std::ostringstream s;
+  s << "Time F X Y D\n";
+  for (int i = 0; i < 10; ++i) s << (i / 2) << " " << 1630 + i << " 1 2 0.5\n";
+  const ResponseRecord r = readResponseText(s.str(), "in.txt");
+  ASSERT_EQ(r.size(), 10u);
+  EXPECT_DOUBLE_EQ(r.t_s[9], 4.0);
+  EXPECT_DOUBLE_EQ(r.frequency_hz[9], 1639.0);
+  EXPECT_DOUBLE_EQ(r.drive[0], 0.5);
+  ASSERT_EQ(r.notes.size(), 1u);
+  EXPECT_NE(r.notes[0].find("5 points share the time stamp"), std::string::npos);
+}
+
+TEST(ResponseReader, AMeasuredDriveKeepsItsSetLevels) {
+  // A current read back with 0.2 % noise at two set levels 30 % apart: two levels, and the sweeps
+  // split only where the set level changes or the frequency turns.
+  std::vector<double> drive;
+  ResponseRecord r;
+  for (int i = 0; i < 40; ++i) {
+    const double set = i < 20 ? 1.0 : 1.3;
+    r.t_s.push_back(i);
+    r.frequency_hz.push_back(100.0 + (i % 20 < 10 ? i % 20 : 19 - i % 20));
+    r.x.push_back(1);
+    r.y.push_back(0);
+    r.drive.push_back(set * (1.0 + 0.002 * ((i * 7919) % 5 - 2)));
+  }
+  const std::vector<int> level = driveLevels(r.drive);
+  EXPECT_EQ(level[0], 0);
+  EXPECT_EQ(level[19], 0);
+  EXPECT_EQ(level[20], 1);
+  EXPECT_EQ(*std::max_element(level.begin(), level.end()), 1);
+  const std::vector<int> sweep = splitSweeps(r);
+  EXPECT_EQ(*std::max_element(sweep.begin(), sweep.end()), 3);  // up, down at each level
 }
 
 }  // namespace

@@ -41,7 +41,12 @@ ResponseRecord readResponseText(const std::string& text, const std::string& sour
 /// Writes `t,frequency_hz,x,y,drive` with the comments as `#` lines.
 void writeResponseCsv(const ResponseRecord& record, std::ostream& out);
 
-/// Sweep index of every point: a new sweep starts where the drive level changes (relative 1e-6),
+/// Drive level of every point (0 = the lowest): the sorted drive values are cut where one exceeds
+/// the level's first value by more than 1 %, so a drive that is measured per point (a current
+/// read back with its noise) still gives its set levels, not one level per point.
+std::vector<int> driveLevels(const std::vector<double>& drive);
+
+/// Sweep index of every point: a new sweep starts where the drive level changes (driveLevels),
 /// the frequency step reverses its sign, the `direction` column changes, or time jumps by more
 /// than 20 median point intervals. Indices count from 0 in time order.
 std::vector<int> splitSweeps(const ResponseRecord& record);
