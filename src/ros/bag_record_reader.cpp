@@ -129,6 +129,23 @@ std::vector<typename M::ConstPtr> readAll(const rosbag::Bag& bag, const std::str
   return out;
 }
 
+/// Messages missing by header sequence number (a publisher numbers its messages 0, 1, ...; a bag
+/// recorded while its recorder's queue overflowed skips numbers). 0 when the bag's messages carry
+/// no numbers (all equal) or the numbers restart (a restarted publisher).
+template <class Ptr>
+uint64_t missingBySequence(const std::vector<Ptr>& msgs) {
+  uint64_t missing = 0;
+  for (size_t i = 1; i < msgs.size(); ++i) {
+    const uint32_t a = msgs[i - 1]->header.seq, b = msgs[i]->header.seq;
+    if (b > a) missing += b - a - 1;
+  }
+  return missing;
+}
+
+void noteMissing(uint64_t missing, std::map<std::string, std::string>* metadata) {
+  if (missing > 0) (*metadata)["messages_missing_by_sequence"] = std::to_string(missing);
+}
+
 std::string where(const std::string& path, const std::string& topic, size_t index) {
   return path + ": topic '" + topic + "' message " + std::to_string(index + 1) + ": ";
 }
@@ -180,6 +197,7 @@ void readSlow(const rosbag::Bag& bag, const std::string& path, const std::string
   checkOmega(rec.omega_rad_s, path, topic);
   rec.metadata["mode"] = "free_decay";
   rec.metadata["stamp_origin"] = stampText(origin);
+  noteMissing(missingBySequence(msgs), &rec.metadata);
   setOmegaMetadata(rec.omega_rad_s, &rec.metadata);
   rec.source = path;
 }
@@ -204,6 +222,7 @@ void readSweep(const rosbag::Bag& bag, const std::string& path, const std::strin
   checkStates(rec.q, messageLocator(path, topic));
   checkOmega(rec.omega_rad_s, path, topic);
   rec.metadata["mode"] = "forced";
+  noteMissing(missingBySequence(msgs), &rec.metadata);
   rec.metadata["stamp_origin"] = stampText(msgs.front()->header.stamp);
   setOmegaMetadata(rec.omega_rad_s, &rec.metadata);
   rec.source = path;
@@ -278,6 +297,7 @@ void readRaw(const rosbag::Bag& bag, const std::string& path, const std::string&
   if (driven) rec.extra["omega0"] = omega0;
   rec.metadata["mode"] = driven ? "forced" : "free_decay";
   rec.metadata["stamp_origin"] = stampText(origin);
+  noteMissing(missingBySequence(msgs), &rec.metadata);
   setOmegaMetadata(rec.omega_rad_s, &rec.metadata);
   rec.source = path;
 }

@@ -1,6 +1,8 @@
 // CSV or bag input for the tool's subcommands (see bag_input.h).
 #include "bag_input.h"
 
+#include <iostream>
+
 #include "cvg_bench/core/model/errors.h"
 #ifdef CVG_WITH_ROSBAG
 #include "cvg_bench/core/demod/demodulator.h"
@@ -33,6 +35,15 @@ AnyRecord readRecordInput(const std::string& path, const RecordReadOptions& opti
   bag_options.kinds = kinds;
   bag_options.repair_raw_timestamps = options.repair_raw_timestamps;
   AnyRecord rec = readRecordBag(path, bag_options);
+  const RecordMetadata& md = rec.kind == RecordKind::kRaw          ? rec.raw.metadata
+                             : rec.kind == RecordKind::kForcedSweep ? rec.sweep.metadata
+                                                                    : rec.slow.metadata;
+  const auto missing = md.find("messages_missing_by_sequence");
+  if (missing != md.end())
+    std::cerr << "cvg_ident: warning: " << path << ": topic '" << md.at("topic") << "': "
+              << missing->second
+              << " messages missing by header sequence number (the recording dropped them; "
+                 "record with launch/record.launch); their span is a gap in the record\n";
   bool wants_slow = false;
   for (RecordKind k : kinds) wants_slow = wants_slow || k == RecordKind::kFreeDecay;
   if (rec.kind != RecordKind::kRaw || !wants_slow) return rec;
@@ -52,6 +63,7 @@ AnyRecord readRecordInput(const std::string& path, const RecordReadOptions& opti
   slow.slow = demodulateUniform(rec.raw, o);
   slow.slow.source = rec.raw.source;
   slow.slow.omega_rad_s = rec.raw.omega_rad_s;
+  if (missing != md.end()) slow.slow.metadata[missing->first] = missing->second;
   slow.slow.metadata["demodulated"] =
       "as demodulator_node with " + config + " at " + std::to_string(o.output_rate_hz) + " Hz";
   return slow;
