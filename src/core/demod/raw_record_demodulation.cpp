@@ -17,6 +17,8 @@ SlowRecord demodulateRawRecord(const RawRecord& input, double omega_rad_s,
   RawRecord raw = input;
   std::ostringstream s;
   s << std::setprecision(8) << "input " << raw.source << " is a raw t,f,g record";
+  const auto columns = raw.metadata.find("columns_read_as");
+  if (columns != raw.metadata.end()) s << " (" << columns->second << ")";
   if (raw.n_reordered > 0 || raw.n_duplicates_dropped > 0)
     s << " (" << raw.n_reordered << " rows reordered, " << raw.n_duplicates_dropped
       << " duplicated timestamps dropped)";

@@ -116,22 +116,29 @@ std::string describeStep(const SelectionStep& s, const CandidateExtension& c, co
   return o.str();
 }
 
-/// A free decay ties amplitude to time (A^2 ~ exp(-2 gamma t)): an amplitude law selected from one
-/// record has a look-alike, a drift in time with the same course (the independent harness's
-/// saturating frequency transient with tau ~ 1/(2 gamma) was fitted as xi + xi_k, i.e. a frequency
-/// law without precession). Said with the time constant; empty otherwise.
+/// A free decay ties amplitude to time (A^2 ~ exp(-gamma_env t), Q = omega / gamma_env): an
+/// amplitude law selected from one record has a look-alike, a drift in time with the same course
+/// (the independent harness's saturating frequency transient with tau ~ 1/(2 gamma) was fitted as
+/// xi + xi_k, i.e. a frequency law without precession). Said with the time constant; empty
+/// otherwise.
 std::string amplitudeTimeCaveat(const Explanation& x, ExperimentMode mode) {
   if (mode != ExperimentMode::kFreeDecay) return "";
   std::vector<std::string> laws;
   for (const auto& t : x.selection.selected)
     if (t == "xi" || t == "kappa" || t == "gamma_nl" || t == "xi_diff" || t == "xi_k")
       laws.push_back(t);
-  const auto g = x.finalEstimate().parameters.find("gamma");
-  if (laws.empty() || g == x.finalEstimate().parameters.end() || !(g->second.value > 0.0))
-    return "";
+  if (laws.empty()) return "";
+  // The time constant from the record's Q (the envelope's decay, which one record identifies),
+  // not from gamma, which a single standing wave does not separate from b_c, b_s, n
+  // (docs/paper.md item 11; the Florence pendulum: gamma gave 111 s, the record's is 4,300 s).
+  const Estimate& e = x.finalEstimate();
+  const auto q = e.derived.find("Q");
   std::ostringstream o;
-  o << " One free decay ties amplitude to time (A^2 ~ exp(-2 gamma t), time constant "
-    << num(0.5 / g->second.value, 3) << " s): the amplitude law";
+  o << " One free decay ties amplitude to time";
+  if (q != e.derived.end() && q->second.value > 0.0 && e.omega_rad_s > 0.0)
+    o << " (the amplitude decays as exp(-t / tau), tau = 2 Q / omega = "
+      << num(2.0 * q->second.value / e.omega_rad_s, 3) << " s)";
+  o << ": the amplitude law";
   o << (laws.size() > 1 ? "s (" : " (");
   for (size_t i = 0; i < laws.size(); ++i) o << (i ? ", " : "") << laws[i];
   o << ") cannot be told with certainty from a drift in time with that course (e.g. a thermal "

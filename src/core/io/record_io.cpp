@@ -1,6 +1,7 @@
 #include "cvg_bench/core/io/record_io.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -455,11 +456,56 @@ const RecordMetadata& AnyRecord::metadata() const {
   }
 }
 
+namespace {
+
+std::string lowered(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+/// A position track written without --columns (a camera's `time;x;y`): the header's time column
+/// (t, time, time_s, timestamp) and one coordinate pair (x,y or f,g), case ignored, become t, f, g.
+/// Only for a header that is no known column set and no --columns map; nothing else is guessed.
+bool positionTrackColumns(const Table& table, RawColumnMap* map, std::string* note) {
+  std::string t, f, g;
+  for (const auto& h : table.header) {
+    const std::string l = lowered(h);
+    if (t.empty() && (l == "t" || l == "time" || l == "time_s" || l == "timestamp")) t = h;
+  }
+  for (const auto& pair : {std::make_pair("x", "y"), std::make_pair("f", "g")}) {
+    for (const auto& h : table.header) {
+      if (f.empty() && lowered(h) == pair.first) f = h;
+      if (g.empty() && lowered(h) == pair.second) g = h;
+    }
+    if (!f.empty() && !g.empty()) break;
+    f.clear();
+    g.clear();
+  }
+  if (t.empty() || f.empty() || g.empty()) return false;
+  map->t = t;
+  map->f = f;
+  map->g = g;
+  *note = "columns " + t + ", " + f + ", " + g + " read as t, f, g (a position track; --columns " +
+          "maps other names)";
+  return true;
+}
+
+bool isDefaultMap(const RawColumnMap& m) {
+  return m.t == "t" && m.f == "f" && m.g == "g";
+}
+
+}  // namespace
+
 AnyRecord readRecordCsvText(const std::string& text, const std::string& source_name,
                             const RecordReadOptions& options) {
   const Table table = parseTable(text, source_name);
   AnyRecord rec;
-  rec.kind = detectKind(table, options.raw_columns);
+  RecordReadOptions o = options;
+  std::string columns_note;
+  if (isDefaultMap(options.raw_columns) && !table.hasAll(kSweepColumns) &&
+      !table.hasAll(kSlowColumns) && !table.hasAll({"t", "f", "g"}))
+    positionTrackColumns(table, &o.raw_columns, &columns_note);
+  rec.kind = detectKind(table, o.raw_columns);
   switch (rec.kind) {
     case RecordKind::kFreeDecay:
       rec.slow = toSlow(table);
@@ -468,7 +514,8 @@ AnyRecord readRecordCsvText(const std::string& text, const std::string& source_n
       rec.sweep = toSweep(table);
       break;
     case RecordKind::kRaw:
-      rec.raw = toRaw(table, options);
+      rec.raw = toRaw(table, o);
+      if (!columns_note.empty()) rec.raw.metadata["columns_read_as"] = columns_note;
       break;
   }
   return rec;
