@@ -7,6 +7,7 @@
 
 #include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/sample_median.h"
 
 namespace cvg_bench {
 namespace report {
@@ -211,6 +212,23 @@ ParameterFile readParameterFile(const std::string& path) {
 
 ParameterFile parameterFileFromJson(nlohmann::json j, const std::string& path) {
   ParameterFile f;
+  // explain --json: the record's own state, median r and k of its measured windows (orbit_reading).
+  if (j.is_object() && j.contains("measured") && j["measured"].is_object() &&
+      j["measured"].contains("windows") && j["measured"]["windows"].is_array()) {
+    std::vector<double> r, k;
+    for (const auto& w : j["measured"]["windows"])
+      if (w.is_object() && w.contains("r") && w["r"].is_number() && w.contains("k") &&
+          w["k"].is_number() && std::isfinite(w["r"].get<double>()) &&
+          std::isfinite(w["k"].get<double>()) && w["r"].get<double>() > 0.0) {
+        r.push_back(w["r"].get<double>());
+        k.push_back(w["k"].get<double>());
+      }
+    if (!r.empty()) {
+      f.has_record_state = true;
+      f.record_r = sampleMedian(r);
+      f.record_k = sampleMedian(k);
+    }
+  }
   // explain --json: the selected model's estimate is its "final" member (interfaces.md).
   if (j.is_object() && !j.contains("parameters") && j.contains("final") && j["final"].is_object()) {
     nlohmann::json final_estimate = j["final"];

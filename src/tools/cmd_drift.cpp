@@ -36,7 +36,9 @@ const char* kHelp =
     "                       [--angular-gain K] [--json FILE]\n"
     "Drift rate theta' of (5.9) [rad/s and deg/h] of the wave pattern at amplitude r, quadrature "
     "k\n"
-    "(record amplitude units) and pattern angle theta [rad]; default r = 1, k = 0.01, a grid of 8\n"
+    "(record amplitude units) and pattern angle theta [rad]; default the record's median r, k "
+    "when\n"
+    "the file is explain --json (its measured windows), else r = 1, k = 0.01; a grid of 8\n"
     "angles on [0, pi/2). Also prints section 4's derived quantities (angular gain K, default "
     "0.4).\n"
     "FILE.json: identify --json, or explain --json (its \"final\" model is used).\n"
@@ -199,7 +201,14 @@ int runDrift(const std::vector<std::string>& argv) {
   if (args.has("theta") && args.has("theta-grid"))
     throw InputError("give either --theta or --theta-grid, not both");
   const ParameterFile pf = readParameterFile(args.get("params"));
-  const double r = args.getDouble("r", 1.0), k = args.getDouble("k", 0.01);
+  // Default state: the record's own (median r, k of explain's measured windows), so that the
+  // table is comparable with the measured rate; r = 1, k = 0.01 for other files.
+  const double r = args.getDouble("r", pf.has_record_state ? pf.record_r : 1.0);
+  const double k = args.getDouble("k", pf.has_record_state ? pf.record_k : 0.01);
+  if (pf.has_record_state && !args.has("r") && !args.has("k"))
+    std::cout << "state: the record's median amplitude r = " << pf.record_r
+              << " and quadrature k = " << pf.record_k
+              << " (explain's measured windows; --r, --k for another)\n";
   const double gain = args.getDouble("angular-gain", 0.4);
   std::vector<double> thetas;
   if (args.has("theta")) {

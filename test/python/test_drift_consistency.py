@@ -61,6 +61,27 @@ class DriftConsistency(unittest.TestCase):
         self.assertIn("gamma_nl", ex["selected"])
         self.assertIn("linear+gamma_nl", p.stdout)  # the envelope and drift name the model used
 
+    def test_drift_of_an_explain_file_defaults_to_the_records_state(self):
+        """Without --r/--k, drift of an explain JSON is evaluated at the record's median amplitude
+        and quadrature over its measured windows (comparable with the measured rate); with them,
+        at the state given."""
+        run(["explain", self.rec, "--mode", "free_decay", "--json", self.path("ex2.json")])
+        p = run(["drift", "--params", self.path("ex2.json"), "--theta-grid", "4",
+                 "--json", self.path("drs.json")])
+        with open(self.path("ex2.json")) as f:
+            windows = json.load(f)["measured"]["windows"]
+        with open(self.path("drs.json")) as f:
+            dr = json.load(f)
+        rs, ks = sorted(w["r"] for w in windows), sorted(w["k"] for w in windows)
+        self.assertAlmostEqual(dr["r"], rs[len(rs) // 2], delta=1e-12 * rs[-1])
+        self.assertAlmostEqual(dr["k"], ks[len(ks) // 2], delta=1e-12 * rs[-1])
+        self.assertIn("the record's median amplitude", p.stdout)
+        run(["drift", "--params", self.path("ex2.json"), "--r", "0.5", "--k", "0.05",
+             "--theta-grid", "4", "--json", self.path("drg.json")])
+        with open(self.path("drg.json")) as f:
+            given = json.load(f)
+        self.assertEqual((given["r"], given["k"]), (0.5, 0.05))
+
     def test_gamma_nl_moves_the_envelope_decay_with_amplitude(self):
         params = {"omega": 21991.0, "model": "linear+gamma_nl",
                   "parameters": {"gamma": 0.05, "nu": 0.0, "b_c": 0.0, "b_s": 0.0, "c_m": 0.0, "n": 0.0,

@@ -28,6 +28,10 @@ struct ParameterFile {
   /// The file's "derived_ci" (identify / explain's section-4 figures, each from what the record
   /// identifies); empty when absent (hand-written parameters).
   std::map<std::string, ParameterEstimate> derived_ci;
+  /// explain --json: the record's median amplitude r and quadrature k over its measured windows
+  /// (drift's default state); has_record_state false otherwise.
+  bool has_record_state = false;
+  double record_r = 0.0, record_k = 0.0;
 };
 ParameterFile readParameterFile(const std::string& path);
 /// The same from parsed JSON (`path` names it in errors).
