@@ -109,5 +109,28 @@ class FoucaultRawRecord(unittest.TestCase):
         self.assertEqual(len(demod), 1)
         self.assertIn(demod[0], text)
 
+    def test_refinement_failures_are_said_and_retried(self):
+        """Subsets whose output-error fit fails from the LS start (here every one with gamma_nl:
+        the trajectory blows up) are retried from the refined fit of a nested subset and said in
+        the notes, not dropped without a word; amplitude-dependent damping is then ranked, and the
+        tool selects the second cubic invariant (xi + xi_k) itself."""
+        ex, _ = self.explain(DATA, ["--columns", COLUMNS])
+        notes = [n for n in ex["notes"] if "output-error fit failed" in n]
+        self.assertTrue(notes)
+        for n in notes:
+            self.assertIn("retried from the refined", n)
+        ranked = {s["model"] for s in ex["selection"]["subsets"]
+                  if s["refined"] and s["criterion"] is not None}
+        self.assertTrue(any("gamma_nl" in m for m in ranked), ranked)
+        # The residual correlation factor comes from a finalist whose trajectory exists (a
+        # diverged one gave zero residuals and c = 1, which made every small term significant).
+        self.assertGreater(ex["selection"]["correlation_factor"], 5.0)
+        self.assertEqual(sorted(ex["selected"]), ["xi", "xi_k"])
+        # A refined subset without a criterion is named in a note.
+        for s in ex["selection"]["subsets"]:
+            if s["refined"] and s["criterion"] is None:
+                self.assertTrue(any(s["model"] in n for n in ex["notes"]), s["model"])
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -221,6 +221,22 @@ Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
   // Adequacy under the noise model: the record's known correlation, else AR(1) of the residuals
   // (residual_noise_model.h); the runs test and the final signature see whitened residuals.
   const std::vector<BlockResidual> adequacy = fitter.adequacyResiduals(x.selection.final_fit);
+  if (adequacy.empty()) {
+    // The final model's trajectory diverges before the record ends: no output-error residuals,
+    // so no adequacy to show; a model that cannot reproduce the record is not adequate.
+    x.noise_model.description = "none (the final model has no trajectory over the record)";
+    x.final_signature = residualSignature(x.final_blocks, mode, stride, options.signature_bins);
+    LackOfFit& lof = x.lack_of_fit;
+    lof.test = "none possible: the trajectory of " + x.selection.final_fit.model +
+               " from its fitted initial state cannot be integrated over the record (it diverges)";
+    lof.worst = "the model's trajectory diverges";
+    lof.noise_model = x.noise_model.description;
+    lof.p_value = lof.p_value_unwhitened = lof.runs_p_value = lof.low_frequency_p_value = 0.0;
+    x.unexplained = true;
+    x.notes.push_back("adequacy: " + lof.test + "; the verdict is unexplained");
+    x.cause = verdict(x, mode, options);
+    return x;
+  }
   const std::vector<double> known = fitter.knownNoiseCorrelation();
   if (mode == ExperimentMode::kForced) {
     // Slow disturbances correlate neighbouring sweep points; the AR(1) is estimated away from

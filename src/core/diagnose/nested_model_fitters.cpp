@@ -269,7 +269,11 @@ class FreeDecayFitter : public NestedModelFitter {
     // The initial state q(t0) at the fitted z by Gauss-Newton (4 unknowns, Jacobian -dq/dq(t0)
     // by forward sensitivities, folded sample by sample into a 5 x 5 factor): the nuisance part
     // of the output-error fit, so that the residuals are the noise alone.
-    Eigen::Vector4d q0 = record_.q.front();
+    // From the output-error fit's own q(t0) where it has one (a start at the noisy first sample
+    // can make an undamped Gauss-Newton step leave the region where the trajectory exists).
+    Eigen::Vector4d q0 = fit.estimate.initial_slow_state.size() == 4
+                             ? Eigen::Vector4d(fit.estimate.initial_slow_state)
+                             : record_.q.front();
     for (int iter = 0; iter < 4; ++iter) {
       IncrementalQr qr(4);
       RegressionBlockMatrix minus_s(4, 4);
@@ -285,11 +289,13 @@ class FreeDecayFitter : public NestedModelFitter {
     }
     Eigen::VectorXd r0 = Eigen::VectorXd::Zero(4 * n);
     std::vector<Eigen::Vector4d> traj;
-    if (integrateSlowTrajectory(model, z, q0, record_.t_s, options_.rk4_substeps, &traj) &&
-        traj.size() == n)
-      for (size_t i = 0; i < n; ++i) r0.segment<4>(4 * i) = record_.q[i] - traj[i];
-    else
-      traj = record_.q;
+    // A model whose trajectory cannot be integrated over the record has no output-error
+    // residuals: nothing (the caller says the adequacy cannot be shown), never zeros that would
+    // pass every test.
+    if (!integrateSlowTrajectory(model, z, q0, record_.t_s, options_.rk4_substeps, &traj) ||
+        traj.size() != n)
+      return {};
+    for (size_t i = 0; i < n; ++i) r0.segment<4>(4 * i) = record_.q[i] - traj[i];
     std::vector<double> t(n);
     for (size_t i = 0; i < n; ++i) t[i] = record_.t_s[i] - record_.t_s.front();
     // Radial and tangential parts along the MODEL's state: projected on the measured q, the

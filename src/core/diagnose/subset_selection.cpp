@@ -167,6 +167,57 @@ class SubsetSearch {
       store(key(todo[i]), &refined_, true, std::move(fits[i]), errors[i]);
   }
 
+  /// A refined fit that fell back to its LS start (the output-error fit failed): retried once from
+  /// the output-error fit of its best nested subset one term smaller (refined first, and retried
+  /// the same way when it fell back too; the added term starts at zero), else of any smaller
+  /// refined subset, the linear model at worst. The retry replaces the cached fit when it
+  /// converges. Said in the notes either way.
+  void retryFallback(const Terms& t) {
+    const std::string k = key(t);
+    const auto it = refined_.find(k);
+    if (it == refined_.end() || it->second.estimate.method == "ceres" || retried_.count(k)) return;
+    retried_[k] = true;
+    std::string why = "reason not recorded";
+    for (const auto& n : it->second.estimate.notes)
+      if (n.find("refinement failed") != std::string::npos) why = n.substr(n.rfind(": ") + 2);
+    for (const auto& name : t) {
+      Terms sub;
+      for (const auto& n : t)
+        if (n != name) sub.push_back(n);
+      refined(sub);
+      retryFallback(sub);
+    }
+    const NestedFit* near = nullptr;
+    for (const auto& kv : refined_) {
+      const NestedFit& c = kv.second;
+      if (c.estimate.method != "ceres" || c.extensions.size() >= t.size()) continue;
+      bool nested = true;
+      for (const auto& e : c.extensions)
+        nested = nested && std::find(t.begin(), t.end(), e) != t.end();
+      if (nested && (!near || c.extensions.size() > near->extensions.size() ||
+                     (c.extensions.size() == near->extensions.size() && c.rss < near->rss)))
+        near = &c;
+    }
+    std::string msg = "subset " + k + ": output-error fit failed from the LS start (" + why + ")";
+    if (!near) {
+      msg += "; no refined nested subset to start from: not ranked";
+    } else {
+      msg += "; retried from the refined " + near->model;
+      try {
+        NestedFit again = fitter_.fitNear(t, *near);
+        if (again.estimate.method == "ceres") {
+          it->second = std::move(again);
+          msg += ": converged";
+        } else {
+          msg += ": failed again: not ranked";
+        }
+      } catch (const std::exception& e) {
+        msg += std::string(": ") + e.what() + ": not ranked";
+      }
+    }
+    if (notes_) notes_->push_back(msg);
+  }
+
   /// The refined fit with its covariance and intervals (NestedFit::finish run once); for the
   /// fits the result reports (baseline, steps, near misses), the others are only ranked.
   const NestedFit* complete(const Terms& t) {
@@ -261,7 +312,7 @@ class SubsetSearch {
   double penalty_floor_ = 0.0;
   std::map<std::string, NestedFit> cheap_, refined_;
   std::map<std::string, double> holdout_;
-  std::map<std::string, bool> failed_;
+  std::map<std::string, bool> failed_, retried_;
 };
 
 /// Stacked output-error residuals of a refined fit (4 per sample).
@@ -341,12 +392,21 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
   double c = c_ls;
   auto fitOf = [&](const Terms& t) { return search.refined(t); };
   if (refined_scale) {
-    const NestedFit* largest = nullptr;
-    for (const auto& t : finalists) {
-      const NestedFit* f = fitOf(t);
-      if (f && (!largest || t.size() > largest->extensions.size())) largest = f;
+    // The largest finalist whose trajectory exists over the record (a fit that diverged has no
+    // output-error residuals; the linear model at worst).
+    std::vector<const NestedFit*> by_size;
+    for (const auto& t : finalists)
+      if (const NestedFit* f = fitOf(t)) by_size.push_back(f);
+    std::stable_sort(by_size.begin(), by_size.end(), [](const NestedFit* a, const NestedFit* b) {
+      return a->extensions.size() > b->extensions.size();
+    });
+    Eigen::VectorXd e;
+    for (const NestedFit* f : by_size) {
+      if (f->estimate.method != "ceres") continue;
+      e = adequacyVector(fitter, *f);
+      if (e.size() > 0) break;
     }
-    c = std::max(longRunVarianceFactor(adequacyVector(fitter, *largest), 4),
+    c = std::max(e.size() > 0 ? longRunVarianceFactor(e, 4) : 1.0,
                  longRunVarianceFactor(fitter.knownNoiseCorrelation()));
   }
   result.correlation_factor = c;
@@ -356,7 +416,12 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
     const auto it = crit.find(k);
     if (it != crit.end()) return it->second;
     const NestedFit* f = fitOf(t);
-    // A free-decay refinement that fell back to LS has residuals in other units: not comparable.
+    // A free-decay refinement that fell back to LS has residuals in other units: not comparable
+    // unless a retry from a refined nested fit converges; said either way (notes).
+    if (f && refined_scale && f->estimate.method != "ceres") {
+      search.retryFallback(t);
+      f = fitOf(t);
+    }
     const bool comparable = f && (!refined_scale || f->estimate.method == "ceres");
     const double v = comparable ? search.criterion(*f, t.size(), c) : kInf;
     crit[k] = v;
