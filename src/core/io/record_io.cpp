@@ -464,9 +464,11 @@ std::string lowered(std::string s) {
 }
 
 /// A position track written without --columns (a camera's `time;x;y`): the header's time column
-/// (t, time, time_s, timestamp) and one coordinate pair (x,y or f,g), case ignored, become t, f, g.
+/// (t, time, time_s, timestamp) and one coordinate pair (x,y or f,g), case ignored, become t, f, g,
+/// in a header of exactly those three columns.
 /// Only for a header that is no known column set and no --columns map; nothing else is guessed.
 bool positionTrackColumns(const Table& table, RawColumnMap* map, std::string* note) {
+  if (table.header.size() != 3) return false;  // t,x,y,z is not guessed: which pair is meant?
   std::string t, f, g;
   for (const auto& h : table.header) {
     const std::string l = lowered(h);
