@@ -59,5 +59,54 @@ class PlotLiveFromBag(unittest.TestCase):
             self.assertEqual(plot_live.main(["--bag", bag_path, "--ns", "gyro_b", "--out", out]), 1)
 
 
+class PlotLiveBenchView(unittest.TestCase):
+    """What a bench engineer keeps open: Q bands that stay positive, lines that break between
+    experiments, the user's zoom kept across redraws, the truth on a simulated bench."""
+
+    def setUp(self):
+        self.m = load_plot_live()
+
+    def test_q_band_stays_positive(self):
+        self.assertEqual(self.m.positive_q_band(2000.0, 1900.0, 2100.0), (1900.0, 2100.0))
+        lo, hi = self.m.positive_q_band(100.0, -20.0, 220.0)  # half-width 120 > Q: open above
+        self.assertAlmostEqual(lo, 100.0 / 2.2)
+        self.assertEqual(hi, math.inf)
+        lo, hi = self.m.positive_q_band(100.0, 0.0, 200.0 - 1e-9)
+        self.assertGreater(lo, 0.0)
+        self.assertGreater(hi, 1e6)
+
+    def test_lines_break_between_experiments(self):
+        rows = [(t, 1.0, 0.0, 2.0) for t in (0.0, 1.0, 2.0, 3.0, 4.0)]
+        segs = self.m.experiment_segments(rows, [(0.0, 1), (2.5, 2)])
+        self.assertEqual([len(s) for s in segs], [3, 2])
+
+    def test_zoom_kept_and_truth_drawn(self):
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        series = self.m.Series()
+        for i in range(5):
+            series.data["Q"].append((float(i), 1000.0 + i, 990.0, 1010.0 + i))
+            series.data["sigma"].append((float(i), 0.1, 0.1, 0.1))
+        series.experiments = [(0.0, 1)]
+        series.truth_q = 1002.0
+        fig = plt.figure()
+        self.m.draw(fig, series, "gyro_a", keep_view=True)
+        self.assertIn("/gyro_a", fig._suptitle.get_text())
+        q_ax = fig.axes[0]
+        self.assertTrue(any(abs(l.get_ydata()[0] - 1002.0) < 1e-9 for l in q_ax.get_lines()
+                            if l.get_linestyle() == "--"))
+        q_ax.set_ylim(1001.0, 1003.0)  # the user zooms
+        series.data["Q"].append((5.0, 1005.0, 995.0, 1015.0))
+        self.m.draw(fig, series, "gyro_a", keep_view=True)
+        self.assertEqual(tuple(fig.axes[0].get_ylim()), (1001.0, 1003.0))
+        # Not zoomed: the next redraw follows the data.
+        ylim_sigma = fig.axes[2].get_ylim()
+        series.data["sigma"].append((6.0, 5.0, 5.0, 5.0))
+        self.m.draw(fig, series, "gyro_a", keep_view=True)
+        self.assertGreater(fig.axes[2].get_ylim()[1], ylim_sigma[1])
+        plt.close(fig)
+
+
 if __name__ == "__main__":
     unittest.main()
