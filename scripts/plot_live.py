@@ -67,7 +67,6 @@ class Series:
             self.data["drift_deg_h"].append((t, msg.drift_rate_deg_h, msg.ci_low_rad_s * to_deg_h,
                                              msg.ci_high_rad_s * to_deg_h))
 
-
     def add_truth(self, msg):
         with self.lock:
             values = dict(zip(msg.names, msg.values))

@@ -24,7 +24,8 @@ QUEUE = 1000000  # messages; rosbag's default of 100 drops a burst silently
 def choose_topics(bag_topics, demodulate):
     """(topics to play, [(topic, why left out)]) for the bag's topic names."""
     run_demod = demodulate == "true" or (demodulate == "auto" and RAW in bag_topics)
-    wanted = [RAW, TRUTH] if run_demod else [SLOW, SWEEP, TRUTH]
+    # Sweep points are never remade by the demodulator: played in both cases.
+    wanted = [RAW, SWEEP, TRUTH] if run_demod else [SLOW, SWEEP, TRUTH]
     play = [t for t in wanted if t in bag_topics]
     left = []
     for t in sorted(bag_topics):
@@ -49,14 +50,17 @@ def missing_by_sequence(seqs):
 
 
 def scan_bag(path, topics=None):
-    """{topic: message count} and {topic: missing by sequence} (headers only)."""
+    """{topic: message count} and {topic: missing by sequence} over `topics` (none read when
+    topics is empty; all when None)."""
     import rosbag
     counts, seqs = {}, {}
     with rosbag.Bag(path) as bag:
         info = bag.get_type_and_topic_info().topics
         for name, t in info.items():
             counts[name] = t.message_count
-        for topic, msg, _ in bag.read_messages(topics=topics or list(info)):
+        if topics is not None and not topics:
+            return counts, {}
+        for topic, msg, _ in bag.read_messages(topics=list(info) if topics is None else topics):
             header = getattr(msg, "header", None)
             if header is not None:
                 seqs.setdefault(topic, []).append(header.seq)
@@ -67,15 +71,22 @@ def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("bag")
     ap.add_argument("--rate", type=float, default=1.0)
-    ap.add_argument("--loop", choices=["true", "false"], default="false")
+    ap.add_argument("--loop", type=str.lower, choices=["true", "false", "1", "0"],
+                    default="false")
     ap.add_argument("--delay", type=float, default=1.0)
-    ap.add_argument("--demodulate", choices=["auto", "true", "false"], default="auto")
+    ap.add_argument("--demodulate", type=str.lower, choices=["auto", "true", "false", "1", "0"],
+                    default="auto")
     ap.add_argument("--ns", default="cvg")
     args, _ = ap.parse_known_args(argv)
+    args.demodulate = {"1": "true", "0": "false"}.get(args.demodulate, args.demodulate)
+    args.loop = {"1": "true", "0": "false"}.get(args.loop, args.loop)
     import rospy
     rospy.init_node("player", disable_signals=True)
     counts, _ = scan_bag(args.bag, topics=[])
     play, left = choose_topics(set(counts), args.demodulate)
+    if args.demodulate == "true" and RAW not in counts:
+        rospy.logwarn("replay: demodulate:=true but %s has no %s: the demodulator gets nothing",
+                      args.bag, RAW)
     if not play:
         rospy.logerr("replay: %s holds none of %s; its topics: %s", args.bag,
                      ", ".join([RAW, SLOW, SWEEP]), ", ".join(sorted(counts)) or "none")
@@ -87,8 +98,10 @@ def main(argv):
         rospy.loginfo("replay: %s left out: %s", t, why)
     for t, n in sorted(missing.items()):
         if n:
+            where = ("the demodulator counts the lost batches in its diagnostics" if t == RAW
+                     else "the identifier marks estimates over them suspect")
             rospy.logwarn("replay: %s: %d messages missing by sequence number (the recording "
-                          "dropped them); estimates over them are marked suspect", t, n)
+                          "dropped them); %s", t, n, where)
     service = "/%s/identify" % args.ns.strip("/")
     try:
         rospy.wait_for_service(service, 30.0)

@@ -111,7 +111,7 @@ void IdentifierNode::clearBuffer() {
   sweep_ = SweepRecord();
   have_latest_ = false;
   new_data_since_identify_ = false;
-  lost_in_buffer_ = 0;
+  lost_gaps_.clear();
   if (rls_) rls_->reset();
   rls_origin_ = ros::Time();
 }
@@ -172,13 +172,20 @@ void IdentifierNode::onReconfigure(IdentifierConfig& c, uint32_t) {
       options_.identify_period_s);
 }
 
-void IdentifierNode::countSequence(uint32_t seq) {
+uint64_t IdentifierNode::lostSince(const ros::Time& since) const {
+  uint64_t n = 0;
+  for (const auto& g : lost_gaps_)
+    if (g.first > since) n += g.second;
+  return n;
+}
+
+void IdentifierNode::countSequence(uint32_t seq, const ros::Time& stamp) {
   ++received_;
   // Publishers number their messages; a skipped number is a message lost on the way (a full
   // subscriber queue). A number going back is a restarted publisher or a looped bag.
   if (have_seq_ && seq > last_seq_) {
     dropped_transport_ += seq - last_seq_ - 1;
-    lost_in_buffer_ += seq - last_seq_ - 1;
+    lost_gaps_.emplace_back(stamp, seq - last_seq_ - 1);
   }
   have_seq_ = true;
   last_seq_ = seq;
@@ -218,7 +225,7 @@ void IdentifierNode::trackExperiment(const ros::Time& epoch, const ros::Time& st
 }
 
 void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
-  countSequence(msg->header.seq);
+  countSequence(msg->header.seq, msg->header.stamp);
   Eigen::Vector4d q;
   try {
     q = slowFromMsg(*msg);
@@ -282,7 +289,7 @@ void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
 
 void IdentifierNode::onSweep(const SweepPoint::ConstPtr& msg) {
   const ros::Time stamp = msg->header.stamp;
-  countSequence(msg->header.seq);
+  countSequence(msg->header.seq, msg->header.stamp);
   trackExperiment(ros::Time(), stamp);
   try {
     appendSweepPoint(*msg, &sweep_);
@@ -391,10 +398,14 @@ void IdentifierNode::publishEstimate() {
   msg.experiment_id = buffer_experiment_;
   msg.experiment_start = buffer_experiment_start_;
   msg.sanity_problems = sanityProblems(estimate_);
-  if (lost_in_buffer_ > 0)
-    msg.sanity_problems.push_back(
-        std::to_string(lost_in_buffer_) +
-        " input messages lost in transport (sequence gaps) since these data began");
+  // Gaps before the window's first sample no longer touch its data (a sliding window).
+  while (!lost_gaps_.empty() && !stamps_.empty() && lost_gaps_.front().first <= stamps_.front())
+    lost_gaps_.pop_front();
+  const uint64_t lost = lostSince(window_start_);
+  if (lost > 0)
+    msg.sanity_problems.push_back(std::to_string(lost) +
+                                  " input messages lost in transport (sequence gaps) within the "
+                                  "data of this estimate");
   msg.suspect = !msg.sanity_problems.empty();
   if (msg.suspect) {
     ++suspect_estimates_;

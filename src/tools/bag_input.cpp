@@ -35,13 +35,13 @@ AnyRecord readRecordInput(const std::string& path, const RecordReadOptions& opti
   bag_options.kinds = kinds;
   bag_options.repair_raw_timestamps = options.repair_raw_timestamps;
   AnyRecord rec = readRecordBag(path, bag_options);
-  const RecordMetadata& md = rec.kind == RecordKind::kRaw          ? rec.raw.metadata
+  const RecordMetadata& md = rec.kind == RecordKind::kRaw           ? rec.raw.metadata
                              : rec.kind == RecordKind::kForcedSweep ? rec.sweep.metadata
                                                                     : rec.slow.metadata;
   const auto missing = md.find("messages_missing_by_sequence");
   if (missing != md.end())
-    std::cerr << "cvg_ident: warning: " << path << ": topic '" << md.at("topic") << "': "
-              << missing->second
+    std::cerr << "cvg_ident: warning: " << path << ": topic '" << md.at("topic")
+              << "': " << missing->second
               << " messages missing by header sequence number (the recording dropped them; "
                  "record with launch/record.launch); their span is a gap in the record\n";
   bool wants_slow = false;

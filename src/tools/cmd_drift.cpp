@@ -205,7 +205,7 @@ int runDrift(const std::vector<std::string>& argv) {
   // table is comparable with the measured rate; r = 1, k = 0.01 for other files.
   const double r = args.getDouble("r", pf.has_record_state ? pf.record_r : 1.0);
   const double k = args.getDouble("k", pf.has_record_state ? pf.record_k : 0.01);
-  if (pf.has_record_state && !args.has("r") && !args.has("k"))
+  if (pf.has_record_state && !args.has("r") && !args.has("k") && !args.has("measured"))
     std::cout << "state: the record's median amplitude r = " << pf.record_r
               << " and quadrature k = " << pf.record_k
               << " (explain's measured windows; --r, --k for another)\n";

@@ -16,6 +16,8 @@ class ReplayPlayer(unittest.TestCase):
         play, left = player.choose_topics(
             {"/cvg/raw", "/cvg/truth", "/cvg/slow", "/cvg/estimate"}, "auto")
         self.assertEqual(play, ["/cvg/raw", "/cvg/truth"])
+        play, _ = player.choose_topics({"/cvg/raw", "/cvg/sweep"}, "auto")  # sweeps are not remade
+        self.assertEqual(play, ["/cvg/raw", "/cvg/sweep"])
         self.assertIn("/cvg/slow", dict(left))
         self.assertIn("afresh", dict(left)["/cvg/slow"])
         self.assertIn("/cvg/estimate", dict(left))

@@ -59,7 +59,9 @@ class IdentifierNode {
   /// buffer.
   void trackExperiment(const ros::Time& epoch, const ros::Time& stamp);
   /// Counts samples lost before reaching the callback (publisher sequence numbers skipped).
-  void countSequence(uint32_t seq);
+  void countSequence(uint32_t seq, const ros::Time& stamp);
+  /// Messages lost in transport among the data an estimate from `since` on uses.
+  uint64_t lostSince(const ros::Time& since) const;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   bool onIdentify(Identify::Request& req, Identify::Response& res);
   bool onGetEstimate(GetEstimate::Request& req, GetEstimate::Response& res);
@@ -116,9 +118,11 @@ class IdentifierNode {
   ros::WallTime last_diag_wall_;
   uint64_t dropped_invalid_ = 0, dropped_duplicate_ = 0, dropped_transport_ = 0, trimmed_ = 0;
   bool have_seq_ = false;
-  // Messages lost in transport (sequence gaps) since the buffer was last cleared: every estimate
-  // over these data is published suspect with the count (issue #27).
-  uint64_t lost_in_buffer_ = 0;
+  // Messages lost in transport (sequence gaps): the stamp of the message after each gap and how
+  // many were missing before it, since the buffer was last cleared; an estimate whose data reach
+  // back over a gap is published suspect with the count (issue #27). Gaps older than the buffer
+  // are dropped as the window slides.
+  std::deque<std::pair<ros::Time, uint64_t>> lost_gaps_;
   uint32_t last_seq_ = 0;
   uint64_t identifications_ = 0, identification_failures_ = 0, suspect_estimates_ = 0;
   double last_identify_wall_s_ = 0.0;

@@ -132,7 +132,8 @@ std::string amplitudeTimeCaveat(const Explanation& x, ExperimentMode mode) {
   // not from gamma, which a single standing wave does not separate from b_c, b_s, n
   // (docs/paper.md item 11; the Florence pendulum: gamma gave 111 s, the record's is 4,300 s).
   const Estimate& e = x.finalEstimate();
-  const auto q = e.derived.find("Q");
+  auto q = e.derived.find("Q_envelope");
+  if (q == e.derived.end()) q = e.derived.find("Q");
   std::ostringstream o;
   o << " One free decay ties amplitude to time";
   if (q != e.derived.end() && q->second.value > 0.0 && e.omega_rad_s > 0.0)
@@ -234,7 +235,11 @@ Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
     lof.p_value = lof.p_value_unwhitened = lof.runs_p_value = lof.low_frequency_p_value = 0.0;
     x.unexplained = true;
     x.notes.push_back("adequacy: " + lof.test + "; the verdict is unexplained");
-    x.cause = verdict(x, mode, options);
+    // The p-values of 0 stand for "no adequacy"; the cause says so instead of quoting them.
+    x.cause = "The final model " + x.selection.final_fit.model +
+              " cannot reproduce the record: its trajectory from the fitted initial state "
+              "diverges before the record ends, so its adequacy cannot be shown (unexplained). " +
+              verdict(x, mode, options);
     return x;
   }
   const std::vector<double> known = fitter.knownNoiseCorrelation();

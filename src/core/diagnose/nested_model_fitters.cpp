@@ -271,9 +271,10 @@ class FreeDecayFitter : public NestedModelFitter {
     // of the output-error fit, so that the residuals are the noise alone.
     // From the output-error fit's own q(t0) where it has one (a start at the noisy first sample
     // can make an undamped Gauss-Newton step leave the region where the trajectory exists).
-    Eigen::Vector4d q0 = fit.estimate.initial_slow_state.size() == 4
-                             ? Eigen::Vector4d(fit.estimate.initial_slow_state)
-                             : record_.q.front();
+    const Eigen::Vector4d start = fit.estimate.initial_slow_state.size() == 4
+                                      ? Eigen::Vector4d(fit.estimate.initial_slow_state)
+                                      : record_.q.front();
+    Eigen::Vector4d q0 = start;
     for (int iter = 0; iter < 4; ++iter) {
       IncrementalQr qr(4);
       RegressionBlockMatrix minus_s(4, 4);
@@ -289,12 +290,16 @@ class FreeDecayFitter : public NestedModelFitter {
     }
     Eigen::VectorXd r0 = Eigen::VectorXd::Zero(4 * n);
     std::vector<Eigen::Vector4d> traj;
-    // A model whose trajectory cannot be integrated over the record has no output-error
-    // residuals: nothing (the caller says the adequacy cannot be shown), never zeros that would
-    // pass every test.
-    if (!integrateSlowTrajectory(model, z, q0, record_.t_s, options_.rk4_substeps, &traj) ||
-        traj.size() != n)
-      return {};
+    // A Gauss-Newton step that left the region where the trajectory exists falls back to the
+    // start; a model whose trajectory cannot be integrated over the record even from there has no
+    // output-error residuals: nothing (the caller says the adequacy cannot be shown), never zeros
+    // that would pass every test.
+    bool ok = integrateSlowTrajectory(model, z, q0, record_.t_s, options_.rk4_substeps, &traj) &&
+              traj.size() == n;
+    if (!ok)
+      ok = integrateSlowTrajectory(model, z, start, record_.t_s, options_.rk4_substeps, &traj) &&
+           traj.size() == n;
+    if (!ok) return {};
     for (size_t i = 0; i < n; ++i) r0.segment<4>(4 * i) = record_.q[i] - traj[i];
     std::vector<double> t(n);
     for (size_t i = 0; i < n; ++i) t[i] = record_.t_s[i] - record_.t_s.front();

@@ -83,9 +83,10 @@ std::string headerName(const std::string& cell) {
   return it == kAliases.end() ? s : it->second;
 }
 
-/// Four headerless columns: t, F, X, Y (one drive level) when the first column never decreases
-/// (a clock) while the second turns round (sweeps); F, X, Y, drive when the fourth is positive
-/// and takes at most one distinct value per 5 rows (set drive levels). Else nothing is guessed.
+/// Four headerless columns: F, X, Y, drive when the fourth is positive and takes at most one
+/// distinct value per 5 rows (set drive levels; checked first: a single up sweep also has a
+/// first column that never decreases); else t, F, X, Y (one drive level) when the first column
+/// never decreases (a clock) while the second turns round (sweeps). Else nothing is guessed.
 std::map<std::string, int> guessFourColumns(const std::string& text, std::string* note) {
   std::istringstream in(text);
   std::string line;
@@ -114,12 +115,6 @@ std::map<std::string, int> guessFourColumns(const std::string& text, std::string
     if (sign != 0 && prev_sign != 0 && sign != prev_sign) second_turns = true;
     if (sign != 0) prev_sign = sign;
   }
-  if (first_clock && second_turns) {
-    *note =
-        "no header and no --columns: 4 columns read as t, frequency_hz, x, y (the first never "
-        "decreases, the second turns round); one drive level";
-    return {{"t", 0}, {"frequency_hz", 1}, {"x", 2}, {"y", 3}};
-  }
   std::sort(fourth.begin(), fourth.end());
   const size_t distinct =
       static_cast<size_t>(std::unique(fourth.begin(), fourth.end()) - fourth.begin());
@@ -129,6 +124,12 @@ std::map<std::string, int> guessFourColumns(const std::string& text, std::string
         "holds " +
         std::to_string(distinct) + " levels)";
     return {{"frequency_hz", 0}, {"x", 1}, {"y", 2}, {"drive", 3}};
+  }
+  if (first_clock && second_turns) {
+    *note =
+        "no header and no --columns: 4 columns read as t, frequency_hz, x, y (the first never "
+        "decreases, the second turns round); one drive level";
+    return {{"t", 0}, {"frequency_hz", 1}, {"x", 2}, {"y", 3}};
   }
   return {};
 }

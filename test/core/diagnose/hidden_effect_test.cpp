@@ -81,10 +81,13 @@ TEST(HiddenEffect, FreeDecayFindsTheDrawnEffect) {
   EXPECT_NEAR(p.value, e.value, 4 * p.std_error) << x.cause;
   // An amplitude law from one decay carries its look-alike in time, with the amplitude's time
   // constant 2 Q / omega (the slow amplitude decays as exp(-gamma t / 2) with Q = omega / gamma:
-  // 2 / gamma here, where gamma is identified).
+  // about 2 / gamma here, where gamma is identified; the envelope adds the anisotropy's part).
   const Estimate& fin = x.finalEstimate();
-  const double tau_s = 2.0 * fin.derived.at("Q").value / fin.omega_rad_s;
-  EXPECT_NEAR(tau_s, 2.0 / fin.parameters.at("gamma").value, 0.02 * tau_s);
+  // The envelope's Q where reported (what the amplitude does, anisotropy included), else Q.
+  const double q =
+      (fin.derived.count("Q_envelope") ? fin.derived.at("Q_envelope") : fin.derived.at("Q")).value;
+  const double tau_s = 2.0 * q / fin.omega_rad_s;
+  EXPECT_NEAR(tau_s, 2.0 / fin.parameters.at("gamma").value, 0.1 * tau_s);
   std::ostringstream tau;
   tau.precision(3);
   tau << "tau = 2 Q / omega = " << tau_s << " s";

@@ -143,6 +143,17 @@ TEST(ResponseReader, FourHeaderlessColumnsAreReadByWhatTheyHold) {
   EXPECT_DOUBLE_EQ(b.frequency_hz[3], 1633.0);
   EXPECT_DOUBLE_EQ(b.drive[14], 2e-8);
   EXPECT_NE(b.notes[0].find("2 levels"), std::string::npos);
+  // F, X, Y, drive of one up sweep per level: the first column never decreases within a level
+  // and Y turns with the noise, yet the fourth's few levels decide.
+  std::string up_sweeps;
+  for (int level = 1; level <= 2; ++level)
+    for (int i = 0; i < 10; ++i)
+      up_sweeps += std::to_string(1630 + i) + " 0.1 " + (i % 2 ? "0.2" : "0.3") + " " +
+                   std::to_string(level) + "e-8\n";
+  const ResponseRecord c = readResponseText(up_sweeps, "in.txt");
+  EXPECT_FALSE(c.has_time);
+  EXPECT_DOUBLE_EQ(c.frequency_hz[9], 1639.0);
+  EXPECT_DOUBLE_EQ(c.drive[19], 2e-8);
   // Neither: nothing is guessed.
   std::string neither;
   for (int i = 0; i < 10; ++i)
