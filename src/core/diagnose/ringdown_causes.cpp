@@ -455,11 +455,13 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     if (best->added == "gamma_nl")
       cs << "Damping grows with the amplitude squared (gas or thermoelastic-like loss): Q0 = "
          << qtext("Q0") << " at zero amplitude, Q = " << qtext("Q")
-         << " at the start of the span; compare resonators by Q0 or at one amplitude. ";
+         << " over the span (its mean decay rate); compare resonators by Q0 or at one "
+            "amplitude. ";
     else if (best->added == "gamma_a")
       cs << "Damping grows linearly with the amplitude (clamping or friction-like loss at the "
             "mount): Q0 = "
-         << qtext("Q0") << ", Q = " << qtext("Q") << " at the start; check the clamping. ";
+         << qtext("Q0") << ", Q = " << qtext("Q")
+         << " over the span (its mean decay rate); check the clamping. ";
     else if (best->added == "beat")
       cs << "Two close modes beat in this channel: split "
          << fmt(fin.derived.at("frequency_split_hz").value) << " Hz, Q1 = " << qtext("Q_mode1")

@@ -538,8 +538,21 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
     const RingdownValue start_rate = deltaValue(
         [sq](const Eigen::VectorXd& q) { return q(1) + q(2) * std::exp((sq ? 2.0 : 1.0) * q(0)); },
         fit.p, fit.cov_hac, fit.cov_crb, z);
-    putQ("Q", start_rate);
-    fit.derived["tau_s"] = qFromRate(start_rate, T);
+    putQ("Q_start", start_rate);
+    // Q of the span: the law's mean decay rate over the fitted span (the level it drops over the
+    // span per unit time, floor left out), i.e. what a straight line through the same decay
+    // gives; the value a ring-down Q is compared by (docs/validation_ringdown_real.md). Q0 is the
+    // zero-amplitude limit, Q_start the rate at the span's first sample.
+    const double t0 = d.t(0), t1 = d.t(n - 1);
+    const std::string law = model;
+    const RingdownValue span_rate = deltaValue(
+        [law, t0, t1](const Eigen::VectorXd& q) {
+          return (ringdownLogAmplitude(law, q, t0, 0.0) - ringdownLogAmplitude(law, q, t1, 0.0)) /
+                 (t1 - t0);
+        },
+        fit.p, fit.cov_hac, fit.cov_crb, z);
+    putQ("Q", span_rate);
+    fit.derived["tau_s"] = qFromRate(span_rate, T);
     if (g0.value < 0.0 || start_rate.value < 0.0) fit.flags.push_back("negative_damping");
     if (gn.value < 0.0) fit.flags.push_back("negative_amplitude_dependent_damping");
   } else if (model == "beat" || model == "two_stage") {

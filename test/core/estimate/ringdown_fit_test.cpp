@@ -165,5 +165,22 @@ TEST(RingdownFit, QAgainstAmplitudeShowsAmplitudeSquaredDamping) {
   EXPECT_TRUE(f.flags.empty());
 }
 
+// Q of an amplitude law is the span's mean decay rate (what a straight line through the same
+// decay gives, the number a ring-down Q is compared by); Q_start and Q0 bracket it.
+TEST(RingdownFit, AmplitudeLawQIsTheSpansMeanDecay) {
+  RingdownSimulationOptions o = bench();
+  o.gamma_nl = M_PI * o.frequency_hz / o.q;
+  o.noise_db = 0.05;
+  const RingdownEnvelope env = ringdownEnvelope(simulateRingdown(o));
+  const RingdownSegment seg = segmentRingdown(env);
+  const RingdownFit law = fitRingdown(env, seg, "gamma_nl");
+  const RingdownFit line = fitRingdown(env, seg, "linear");
+  const double q = law.derived.at("Q").value;
+  EXPECT_LT(law.derived.at("Q_start").value, 0.9 * q);
+  EXPECT_GT(law.derived.at("Q0").value, 1.02 * q);
+  EXPECT_NEAR(q / line.derived.at("Q").value, 1.0, 0.03);
+  EXPECT_GT(law.derived.at("Q").std, 0.0);
+}
+
 }  // namespace
 }  // namespace cvg_bench
