@@ -7,7 +7,9 @@ instrument behaviour behind it; Q must come within 5 % of the authors' published
 - D141: the same after a glitch of three samples at the top of the scale (Q 9x);
 - D293: the decay meets a floor that wanders (no floor found, an amplitude law called);
 - D126: a step at switch-off;
-- D146: a switch-off transient that undershoots the decay's line and comes back.
+- D146: a switch-off transient that undershoots the decay's line and comes back;
+- D309, D145 (refused before 28 Nov): a decay followed by the drive on again, or by a clipped
+  stretch at the drive level; D061: an amplitude law's Q is the span's mean decay.
 Every Q interval must be positive and of non-zero width, and the span part of the uncertainty
 must be reported. Skipped when the data or the tool is absent."""
 import csv
@@ -72,6 +74,22 @@ class RealRingdowns(unittest.TestCase):
 
     def test_switch_off_transient(self):
         self.check("D146", "dips")
+
+    def test_decay_then_drive_on_again(self):
+        # Refused before 28 Nov: the highest drive-on stretch is the last, nothing decays after it.
+        self.check("D309", "holds no decay")
+
+    def test_decay_then_clipped_stretch(self):
+        # A clipped stretch at the drive level after the decay was read as a re-excitation.
+        self.check("D145", "holds no decay")
+
+    def test_amplitude_law_reports_the_spans_mean_decay(self):
+        # gamma_nl selected on a clean decay: Q is the span's mean decay (Q_start was reported
+        # before, 0.84x the authors'), Q0 above it.
+        j = self.check("D061", "")
+        d = j["final"]["derived_ci"]
+        if "Q0" in d:
+            self.assertGreater(d["Q0"]["value"], d["Q"]["value"])
 
 if __name__ == "__main__":
     unittest.main()

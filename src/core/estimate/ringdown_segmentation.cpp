@@ -553,15 +553,30 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     correctWithStraightSpan(env, options.floor_margin_db, &seg, &why);
   } else {
     // The plateau-and-floor reading found no decay: a straight stretch of 10 dB or more is one.
+    std::string window_why = w.why;
     for (size_t i = w.first; i < w.last; ++i) dropout[i] = !std::isfinite(env.log_amplitude[i]);
-    const StraightSpan ss = findStraightSpan(env.t_s, env.log_amplitude, dropout);
-    if (!ss.ok || ss.span_db < 10.0)
-      throw AnalysisError(refusal + (w.why.empty() ? "" : " [" + w.why + "]"));
+    StraightSpan ss = findStraightSpan(env.t_s, env.log_amplitude, dropout);
+    if (!ss.ok || ss.span_db < 10.0) {
+      // None in the window either: the whole record, from each of its drive-on stretches (a
+      // decay followed by a re-excitation, or by a clipped stretch the window took for one).
+      std::vector<bool> all(env.size());
+      for (size_t i = 0; i < env.size(); ++i) all[i] = !std::isfinite(env.log_amplitude[i]);
+      StraightSpanOptions every;
+      every.all_peaks = true;
+      const StraightSpan whole = findStraightSpan(env.t_s, env.log_amplitude, all, every);
+      if (!whole.ok || whole.span_db < 10.0)
+        throw AnalysisError(refusal + (w.why.empty() ? "" : " [" + w.why + "]"));
+      ss = whole;
+      dropout = std::move(all);
+      window_why = "the window read (" + (w.why.empty() ? std::string("the whole record") : w.why) +
+                   ") holds no decay; the whole record is read from each drive-on stretch";
+    }
     seg.dropout = std::move(dropout);
     seg.drive_off_s = env.t_s[ss.i_start];
     setSpan(env, ss.i_start, ss.i_end, &seg);
+    why.str("");
     why.precision(4);
-    why << (w.why.empty() ? "" : "; ") << "no plateau or floor read (" << refusal
+    why << window_why << (window_why.empty() ? "" : "; ") << "no plateau or floor read (" << refusal
         << "); a straight decay of " << ss.span_db << " dB from " << seg.t_start_s << " s to "
         << seg.t_end_s << " s, ending in " << ss.endName();
   }

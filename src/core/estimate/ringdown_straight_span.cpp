@@ -111,21 +111,30 @@ StraightSpan findStraightSpan(const std::vector<double>& t, const std::vector<do
   size_t ip = 0;
   for (size_t i = 1; i + hw < m; ++i)
     if (wide[i] > wide[ip]) ip = i;
-  // 2-3. Candidates from falls below the peak.
+  std::vector<size_t> peaks{ip};
+  if (o.all_peaks) {
+    // The last sample of each run within peak_near_db of the top, in time order.
+    peaks.clear();
+    for (size_t i = 0; i + hw < m; ++i)
+      if (wide[i] >= wide[ip] - o.peak_near_db && !(i + 1 + hw < m && wide[i + 1] >= wide[ip] - o.peak_near_db))
+        peaks.push_back(i);
+  }
+  // 2-3. Candidates from falls below the peak(s).
   bool found = false;
   Grown best;
   double best_db = 0.0, best_score = 0.0;
-  for (const double drop : {1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 17.0, 23.0, 30.0, 40.0}) {
-    size_t a = ip;
-    while (a + 1 < m && sm[a] > sm[ip] - drop) ++a;
-    if (a + 7 >= m) break;
-    Grown g;
-    if (!grow(u, sm, a, o.first_db, tol, run, &g)) continue;
-    const double span_db = -g.c(1) * (u[g.e] - u[g.a]);
-    const double score = span_db * std::sqrt(double(g.e - g.a + 1));
-    if (!found || score > 1.05 * best_score)
-      found = true, best = g, best_db = span_db, best_score = score;
-  }
+  for (const size_t pk : peaks)
+    for (const double drop : {1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 17.0, 23.0, 30.0, 40.0}) {
+      size_t a = pk;
+      while (a + 1 < m && sm[a] > sm[pk] - drop) ++a;
+      if (a + 7 >= m) break;
+      Grown g;
+      if (!grow(u, sm, a, o.first_db, tol, run, &g)) continue;
+      const double span_db = -g.c(1) * (u[g.e] - u[g.a]);
+      const double score = span_db * std::sqrt(double(g.e - g.a + 1));
+      if (!found || score > 1.05 * best_score)
+        found = true, best = g, best_db = span_db, best_score = score;
+    }
   if (!found) return out;
   out.ok = true;
   out.i_start = first[best.a];

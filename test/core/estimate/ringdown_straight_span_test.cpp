@@ -75,5 +75,31 @@ TEST(RingdownStraightSpan, NoDecayIsNoStretch) {
   EXPECT_FALSE(findStraightSpan(r.t, r.y, r.skip).ok);
 }
 
+
+// A decay followed by the drive on again to the record's end (the development set's D309 shape):
+// from the highest peak (the last stretch) nothing falls; all_peaks finds the decay after the
+// first stretch.
+TEST(RingdownStraightSpan, AllPeaksFindsADecayBeforeARexcitation) {
+  const Rec r = make(
+      600,
+      [](double t) {
+        if (t < 100) return 0.0;
+        if (t >= 300) return 0.5;  // drive on again, a little higher
+        return std::max(-0.4 * (t - 100), -60.0);
+      },
+      0.3);
+  const StraightSpan top = findStraightSpan(r.t, r.y, r.skip);
+  EXPECT_FALSE(top.ok && top.span_db >= 10.0);
+  StraightSpanOptions o;
+  o.all_peaks = true;
+  const StraightSpan s = findStraightSpan(r.t, r.y, r.skip, o);
+  ASSERT_TRUE(s.ok);
+  EXPECT_NEAR(s.slope_db_s, -0.4, 0.01);
+  EXPECT_GE(s.i_start, 100u);
+  EXPECT_LE(s.i_start, 115u);
+  EXPECT_LE(s.i_end, 255u);
+  EXPECT_GT(s.span_db, 40.0);
+}
+
 }  // namespace
 }  // namespace cvg_bench

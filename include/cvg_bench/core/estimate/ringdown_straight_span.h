@@ -4,7 +4,7 @@
 //     median of 1/300 of them (a switch-off transient of ten samples stays visible); its robust
 //     sample-to-sample sd sets the tolerance tol = max(tol_db, 4 sd).
 //  2. From each start where the level first falls 1, 2, 3, 5, 8, 12, 17, 23, 30 or 40 dB below
-//     its peak, the first `first_db` of fall must lie on a line within tol; the line is then
+//     its peak (or each of its peaks with all_peaks), the first `first_db` of fall must lie on a line within tol; the line is then
 //     extended sample by sample (refitted every tenth of its length) until `run` consecutive
 //     samples (1 % of the grid, at least 3) leave it by more than tol.
 //  3. The candidate with the largest fall in dB times the square root of its samples wins (an
@@ -30,6 +30,11 @@ struct StraightSpanOptions {
   /// decays keep over 0.28 of their early rate (gamma_a) and its two-stage decays' straightest
   /// stretch is the slow stage, which runs to the floor.
   double flat_fraction = 0.2;
+  /// Start from every peak, not only the highest: the end of each run of the level within
+  /// `peak_near_db` of the top (a record that holds several drive-on stretches, one of them
+  /// followed by the decay). Used where the plateau-and-floor reading found no decay.
+  bool all_peaks = false;
+  double peak_near_db = 3.0;
 };
 
 enum class StraightSpanEnd { kRecordEnd, kFloor, kSmoothRise, kFall };
