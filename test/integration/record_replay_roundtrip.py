@@ -8,19 +8,23 @@ closed: no .bag.active is left). The bag is then replayed with launch/replay.lau
 it (`roslaunch cvg_bench replay.launch bag:=... ns:=replay`: scripts/replay_player.py plays the
 bag's /cvg/raw and /cvg/truth into /replay, a fresh demodulator and identifier there, simulated
 time). Asserted:
-- nothing lost anywhere, by sequence numbers and counts: the live demodulator and identifier lost
-  nothing; the bag holds every raw batch the simulator published (header.seq 0..N-1 plus the empty
-  end-of-record batch) and every slow state the live demodulator published; the replay's
+- no input lost, by sequence numbers and counts: the live demodulator and identifier lost
+  nothing; the bag holds the replay's whole input, every raw batch the simulator published
+  (header.seq 0..N-1 plus the empty end-of-record batch) and the experiment's truth; the replay's
   demodulator receives every raw sample and makes as many slow states as the live one, the
   replay's identifier receives them all, neither counts a loss, and no estimate carries a
   lost-input reason;
+- the recorded /cvg/slow (kept for comparison, not replayed) may miss messages: rosbag record
+  subscribes with a fixed queue of 100 messages and the demodulator publishes a burst per raw
+  batch; every missing one must show as a missing sequence number (counted in the JSON line);
 - the replayed final estimate of the experiment equals the live one to the digits the tools print:
-  every parameter value as `cvg_ident identify` prints it ('%.8g'), its interval ('%.6g'), sigma-hat,
-  omega, the sample count and window stamps, and the derived Q, frequency error, frequency split,
-  zero-rate and damping anisotropy (value '%.8g', interval '%.6g');
+  every parameter value as `cvg_ident identify` prints it ('%.8g'), its interval ('%.6g'),
+  sigma-hat, omega, the sample count and window stamps, and the derived Q, frequency error,
+  frequency split, zero-rate and damping anisotropy (value '%.8g', interval '%.6g');
 - the bag's own last /cvg/estimate (what the live identifier published, recorded for comparison)
   prints the same as the live final estimate.
-The figures are printed as a ROUNDTRIP JSON line (and appended to $CVG_LOAD_REPORT when set)."""
+The figures are printed as a ROUNDTRIP JSON line (and appended to $CVG_LOAD_REPORT when set);
+CVG_ROUNDTRIP_KEEP=1 keeps the bag and the launches' logs (the path is printed)."""
 import json
 import os
 import shutil
@@ -30,9 +34,11 @@ import tempfile
 import threading
 import time
 import unittest
+import xmlrpc.client
 
 import rosbag
 import rosgraph
+import rosnode
 import rospy
 import rostest
 
@@ -113,10 +119,18 @@ class Chain(object):
             s.unregister()
 
 
-def subscribed(node, topics):
-    """True when `node` is registered with the master as a subscriber of every topic."""
-    _, subs, _ = rosgraph.Master("/record_replay_roundtrip").getSystemState()
-    have = {t for t, nodes in subs if node in nodes}
+def connected(node, topics):
+    """True when `node` has an incoming connection from a publisher of every topic (its bus
+    info; registration with the master alone precedes the TCP connection)."""
+    try:
+        uri = rosnode.get_api_uri(rosgraph.Master("/record_replay_roundtrip"), node)
+        if not uri:
+            return False
+        info = xmlrpc.client.ServerProxy(uri).getBusInfo("/record_replay_roundtrip")[2]
+    except (OSError, rosnode.ROSNodeIOException, xmlrpc.client.Error):
+        return False  # not up yet
+    # Rows: [connection id, peer, direction, transport, topic, connected, ...].
+    have = {c[4] for c in info if c[2] == "i" and (len(c) < 6 or c[5])}
     return all(t in have for t in topics)
 
 
@@ -133,17 +147,24 @@ def stop_launch(proc, timeout_s):
 
 class RecordReplayRoundtrip(unittest.TestCase):
     def setUp(self):
+        self.maxDiff = None  # a failure shows every printed quantity that differs
         self.tmp = tempfile.mkdtemp(prefix="cvg_roundtrip_", dir="/tmp")
         self.bag = os.path.join(self.tmp, "run.bag")
         self.recorder = None
         self.replay = None
+        self.logs = []
         self.live = Chain(LIVE)
 
     def tearDown(self):
         stop_launch(self.recorder, 30.0)
         stop_launch(self.replay, 30.0)
         self.live.close()
-        shutil.rmtree(self.tmp, ignore_errors=True)
+        for log in self.logs:
+            log.close()
+        if os.environ.get("CVG_ROUNDTRIP_KEEP"):  # the bag and the launches' logs, to look into
+            print("ROUNDTRIP kept " + self.tmp)
+        else:
+            shutil.rmtree(self.tmp, ignore_errors=True)
 
     def wait(self, what, timeout_s, message):
         deadline = time.monotonic() + timeout_s
@@ -155,6 +176,7 @@ class RecordReplayRoundtrip(unittest.TestCase):
 
     def roslaunch(self, launch_file, *args):
         log = open(os.path.join(self.tmp, launch_file + ".log"), "w")
+        self.logs.append(log)
         return subprocess.Popen(["roslaunch", "cvg_bench", launch_file] + list(args),
                                 stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
 
@@ -179,9 +201,8 @@ class RecordReplayRoundtrip(unittest.TestCase):
 
         # 1. Record, as launch/record.launch records (its topic list, its buffer).
         self.recorder = self.roslaunch("record.launch", "bag:=" + self.bag)
-        self.wait(lambda: subscribed("/recorder_cvg", RECORDED), 30.0,
-                  "record.launch's recorder did not subscribe to %s" % RECORDED)
-        time.sleep(0.5)  # the publishers connect to the new subscriber (TCP) after registration
+        self.wait(lambda: connected("/recorder_cvg", RECORDED), 30.0,
+                  "record.launch's recorder is not connected to every publisher of %s" % RECORDED)
 
         # 2. A live experiment, to its settled final estimate.
         self.wait(lambda: "resonator_simulator" in self.live.diag, 10.0, "no simulator diagnostics")
@@ -190,8 +211,11 @@ class RecordReplayRoundtrip(unittest.TestCase):
 
         def live_done():
             sim = self.live.diag.get("resonator_simulator")
+            demod = self.live.diag.get("demodulator")
             return (sim is not None and sim["summary"] == "idle"
-                    and int(sim["experiments_started"]) == 1 and self.settled(self.live, 1, None))
+                    and int(sim["experiments_started"]) == 1 and demod is not None
+                    and float(demod["input_rate_samples_per_s"]) == 0.0
+                    and self.settled(self.live, 1, int(demod["slow_states_published"])))
         self.wait(live_done, 60.0, "the live experiment did not finish and settle")
         timing["live_s"] = round(time.monotonic() - t_start, 1)
         live_est, live_derived, _ = self.live.final(1)
@@ -219,7 +243,7 @@ class RecordReplayRoundtrip(unittest.TestCase):
         self.assertTrue(os.path.exists(self.bag), "no bag written")
         timing["recorder_stop_s"] = round(time.monotonic() - t_stop, 1)
 
-        # The bag holds everything, numbered without a gap.
+        # The bag holds the replay's input whole (raw batches, truth), numbered without a gap.
         seqs = {}
         bag_estimates = []
         with rosbag.Bag(self.bag) as bag:
@@ -231,10 +255,15 @@ class RecordReplayRoundtrip(unittest.TestCase):
         self.assertEqual(raw_seq, list(range(raw_batches + 1)),
                          "raw batches in the bag: %d of %d + end marker" % (len(raw_seq),
                                                                            raw_batches))
-        slow_seq = seqs.get("/cvg/slow", [])
-        self.assertEqual(len(slow_seq), slow_published)
-        self.assertEqual(slow_seq, list(range(slow_seq[0], slow_seq[0] + len(slow_seq))))
         self.assertEqual(len(seqs.get("/cvg/truth", [])), 1)
+        # The recorded slow states are not replayed (the demodulator makes them afresh), only kept
+        # for comparison; what the recorder lost of them must show as missing sequence numbers.
+        slow_seq = seqs.get("/cvg/slow", [])
+        self.assertTrue(slow_seq, "no /cvg/slow in the bag")
+        self.assertEqual(slow_seq, sorted(set(slow_seq)))
+        slow_missing = slow_seq[0] + sum(b - a - 1 for a, b in zip(slow_seq, slow_seq[1:]))
+        self.assertEqual(len(slow_seq) + slow_missing, slow_published,
+                         "recorded /cvg/slow: lost messages not visible by sequence number")
         self.assertTrue(bag_estimates, "no /cvg/estimate in the bag")
         live_printed = printed(live_est, live_derived)
         self.assertEqual(printed(bag_estimates[-1], live_derived), live_printed,
@@ -277,7 +306,9 @@ class RecordReplayRoundtrip(unittest.TestCase):
         differ = {k: (v, replay_printed.get(k)) for k, v in live_printed.items()
                   if replay_printed.get(k) != v}
         report = {"duration_s": duration_s, "raw_samples": n_raw, "raw_batches": raw_batches,
-                  "slow_states": slow_published, "bag_mb": round(os.path.getsize(self.bag) / 1e6, 1),
+                  "slow_states": slow_published, "bag_slow_states": len(slow_seq),
+                  "bag_slow_missing_by_seq": slow_missing,
+                  "bag_mb": round(os.path.getsize(self.bag) / 1e6, 1),
                   "gamma": live_printed["gamma"], "Q": live_printed["Q"],
                   "frequency_error_hz": live_printed["frequency_error_hz"],
                   "frequency_split_hz": live_printed["frequency_split_hz"],
