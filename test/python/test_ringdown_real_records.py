@@ -9,7 +9,8 @@ instrument behaviour behind it; Q must come within 5 % of the authors' published
 - D126: a step at switch-off;
 - D146: a switch-off transient that undershoots the decay's line and comes back;
 - D309, D145 (refused before 28 Nov): a decay followed by the drive on again, or by a clipped
-  stretch at the drive level; D061: an amplitude law's Q is the span's mean decay.
+  stretch at the drive level; D061: an amplitude law's Q is the span's mean decay; D204, D103: a
+  tail that bends into a floor no rule confirmed.
 Every Q interval must be positive and of non-zero width, and the span part of the uncertainty
 must be reported. Skipped when the data or the tool is absent."""
 import csv
@@ -82,6 +83,12 @@ class RealRingdowns(unittest.TestCase):
     def test_decay_then_clipped_stretch(self):
         # A clipped stretch at the drive level after the decay was read as a re-excitation.
         self.check("D145", "holds no decay")
+
+    def test_tail_bending_into_an_unconfirmed_floor(self):
+        # No floor confirmed or suspected; the last quarter slows and scatters more: the span
+        # ends where the level leaves the decay's line (Q was 1.16x / 1.06x with the tail).
+        self.check("D204", "leaves the decay's line upwards")
+        self.check("D103", "leaves the decay's line upwards")
 
     def test_amplitude_law_reports_the_spans_mean_decay(self):
         # gamma_nl selected on a clean decay: Q is the span's mean decay (Q_start was reported

@@ -523,6 +523,63 @@ void correctWithStraightSpan(const RingdownEnvelope& env, double margin_db, Ring
   if (a != seg->i_start || b != seg->i_end) setSpan(env, a, b, seg);
 }
 
+/// A tail that bends into a floor nobody confirmed: over the span's last quarter the level falls
+/// at under half the rate of its middle half while its sample-to-sample scatter grows by half
+/// (additive noise taking over as the signal sinks into it). A damping law slows the decay
+/// without the scatter growing (the relative noise stays), so it keeps its tail. The span then
+/// ends where the smoothed level leaves the line of its first three quarters by more than the
+/// tolerance for good (docs/validation_ringdown_real.md, "tails").
+void trimFloorTail(const RingdownEnvelope& env, RingdownSegment* seg, std::ostringstream* why) {
+  std::vector<size_t> idx;
+  for (size_t i = seg->i_start; i < seg->i_end; ++i)
+    if (!seg->dropout[i] && std::isfinite(env.log_amplitude[i])) idx.push_back(i);
+  const size_t n = idx.size();
+  if (n < 60) return;
+  std::vector<double> t(n), y(n);
+  for (size_t k = 0; k < n; ++k)
+    t[k] = env.t_s[idx[k]], y[k] = env.log_amplitude[idx[k]] * kDbPerNeper;
+  const std::vector<bool> none(n, false);
+  const std::vector<double> sm = runningMedian(y, none, std::max<int>(2, n / 60));
+  const size_t q1 = n / 4, q2 = n / 2, q3 = 3 * n / 4;
+  const double s_mid = slopeOver(t, sm, none, q1, q3);
+  const double s_end = slopeOver(t, sm, none, q3, n);
+  if (!(s_mid < 0.0) || !(s_end > 0.5 * s_mid)) return;
+  auto roughness = [&](size_t a, size_t b) {
+    std::vector<double> d;
+    for (size_t k = a + 1; k < b; ++k) d.push_back(std::fabs(y[k] - y[k - 1]));
+    return 1.4826 * median(d) / std::sqrt(2.0);
+  };
+  const double r_mid = roughness(q1, q3), r_end = roughness(q3, n);
+  if (!(r_end > 1.5 * r_mid)) return;
+  // The line of the first three quarters; the tail leaves it for good where `run` consecutive
+  // smoothed levels lie above it by more than the tolerance.
+  Eigen::MatrixXd X(q3, 2);
+  Eigen::VectorXd Y(q3);
+  for (size_t k = 0; k < q3; ++k) X(k, 0) = 1.0, X(k, 1) = t[k] - t[0], Y(k) = sm[k];
+  const Eigen::Vector2d c = X.colPivHouseholderQr().solve(Y);
+  const double tol = std::max(1.5, 4.0 * r_mid);
+  const size_t run = std::max<size_t>(3, n / 100);
+  size_t cut = n, above = 0;
+  for (size_t k = q2; k < n; ++k) {
+    if (sm[k] - c(0) - c(1) * (t[k] - t[0]) > tol) {
+      if (++above >= run) {
+        cut = k + 1 - above;
+        break;
+      }
+    } else {
+      above = 0;
+    }
+  }
+  if (cut >= n) return;
+  const double kept_db = -c(1) * (t[cut - 1] - t[0]);
+  if (kept_db < 10.0) return;
+  why->precision(4);
+  *why << "; from " << t[cut] << " s the level leaves the decay's line upwards (over its last "
+       << "quarter it falls at " << s_end << " dB/s against " << s_mid << " dB/s, its scatter "
+       << r_end << " dB against " << r_mid << " dB: a floor taking over): the span ends there";
+  setSpan(env, seg->i_start, idx[cut - 1] + 1, seg);
+}
+
 }  // namespace
 
 RingdownSegment segmentRingdown(const RingdownEnvelope& env,
@@ -551,6 +608,8 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     seg.i_end += w.first;
     why << (w.why.empty() ? "" : "; ") << seg.why;
     correctWithStraightSpan(env, options.floor_margin_db, &seg, &why);
+    if (!seg.has_floor && !std::isfinite(seg.suspected_floor_log_amplitude))
+      trimFloorTail(env, &seg, &why);
   } else {
     // The plateau-and-floor reading found no decay: a straight stretch of 10 dB or more is one.
     std::string window_why = w.why;

@@ -1,9 +1,11 @@
 // Known-answer tests of the ring-down segmentation and fit on records of the ring-down generator.
 #include "cvg_bench/core/estimate/ringdown_fit.h"
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/ringdown_simulator.h"
@@ -180,6 +182,33 @@ TEST(RingdownFit, AmplitudeLawQIsTheSpansMeanDecay) {
   EXPECT_GT(law.derived.at("Q0").value, 1.02 * q);
   EXPECT_NEAR(q / line.derived.at("Q").value, 1.0, 0.03);
   EXPECT_GT(law.derived.at("Q").std, 0.0);
+}
+
+
+// A decay that bends into a floor that wanders fast, the record ending 3 dB under the floor's
+// level (too little floor to confirm one): the span must end above the bend (here the suspected
+// floor rule ends it; on real records where that rule finds nothing, the tail rule does, see
+// test_ringdown_real_records.py D204/D103), and Q is the decay's, not the bend's.
+TEST(RingdownFit, TailBendingIntoAFastWanderingFloorIsLeftOut) {
+  std::mt19937 gen(11);
+  std::normal_distribution<double> e(0.0, 1.0);
+  RingdownEnvelope env;
+  env.frequency_hz = 1.0e4;
+  const double rate = 0.5 / (20.0 / std::log(10.0));  // 0.5 dB/s in ln A per s
+  for (int i = 0; i < 1060; ++i) {
+    const double t = 0.1 * i;  // 120 s: plateau 10 s, then 55 dB of decay towards a -42 dB floor
+    const double a = t < 10.0 ? 1.0 : std::exp(-rate * (t - 10.0));
+    const double floor_rms = std::pow(10.0, (-45.0 + 3.0 * std::sin(t / 1.5)) / 20.0);
+    const double re = a * (1.0 + 0.01 * e(gen)) + floor_rms * e(gen) / std::sqrt(2.0);
+    const double im = floor_rms * e(gen) / std::sqrt(2.0);
+    env.t_s.push_back(t);
+    env.log_amplitude.push_back(0.5 * std::log(re * re + im * im));
+  }
+  const RingdownSegment seg = segmentRingdown(env);
+  const RingdownFit f = fitRingdown(env, seg, "linear");
+  const double q_true = M_PI * env.frequency_hz / rate;
+  EXPECT_LT(seg.t_end_s, 88.0) << seg.why;  // -39 dB at 88 s: the bend starts a few dB above
+  EXPECT_NEAR(f.derived.at("Q").value / q_true, 1.0, 0.03) << seg.why;
 }
 
 }  // namespace
