@@ -1,6 +1,7 @@
 // demodulator_node (see demodulator_node.h).
 #include "cvg_bench/ros/demodulator_node.h"
 
+#include "cvg_bench/InputLoss.h"
 #include "cvg_bench/SlowState.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/ros/conversions.h"
@@ -20,6 +21,7 @@ DemodulatorNode::DemodulatorNode(const ros::NodeHandle& nh, const ros::NodeHandl
   if (options_.omega_rad_s > 0.0 && options_.sample_rate_hz > 0.0)
     configure(options_.omega_rad_s, options_.sample_rate_hz);  // fail at start-up, not later
   slow_pub_ = nh_.advertise<SlowState>("slow", options_.queue_size);
+  loss_pub_ = nh_.advertise<InputLoss>("input_loss", 100);
   raw_sub_ = nh_.subscribe("raw", options_.raw_queue_size, &DemodulatorNode::onRaw, this);
   reset_srv_ = nh_.advertiseService("demodulator/reset", &DemodulatorNode::onReset, this);
   diagnostics_.setHardwareID("cvg_bench demodulator");
@@ -66,14 +68,20 @@ bool DemodulatorNode::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Re
 void DemodulatorNode::onRaw(const RawSampleBatch::ConstPtr& msg) {
   ++batches_;
   samples_in_ += msg->f.size();
-  if (have_seq_ && msg->header.seq > last_seq_) batches_lost_ += msg->header.seq - last_seq_ - 1;
+  const uint32_t gap =
+      have_seq_ && msg->header.seq > last_seq_ ? msg->header.seq - last_seq_ - 1 : 0;
+  batches_lost_ += gap;
   have_seq_ = true;
   last_seq_ = msg->header.seq;
   // An empty batch marks the end of a record (its sequence number above counted any lost tail).
   if (msg->f.empty() && msg->g.empty() && msg->time_offsets_s.empty()) {
     ++end_markers_;
+    if (gap > 0) publishLoss(gap, last_end_.isZero() ? msg->header.stamp : last_end_);
     return;
   }
+  // Lost batches are announced at the data they precede (this batch's first sample), so that
+  // the identifier marks the estimates whose data span them (InputLoss.msg).
+  if (gap > 0) publishLoss(gap, msg->header.stamp);
   const ros::Time now = ros::Time::now();
   // A /clock that jumps back (replay restarted) is reported; the reset itself is decided by the
   // data's own stamps below, so a batch processed before the clock message is not reset twice.
@@ -135,6 +143,18 @@ void DemodulatorNode::onRaw(const RawSampleBatch::ConstPtr& msg) {
   }
   if (!samples.t_s.empty()) last_end_ = timeAfter(epoch_, samples.t_s.back());
   warnAboutDrops();
+}
+
+void DemodulatorNode::publishLoss(uint32_t batches, const ros::Time& stamp) {
+  InputLoss loss;
+  loss.header.stamp = stamp;
+  loss.batches_lost = batches;
+  loss.source = "demodulator: raw batches";
+  loss_pub_.publish(loss);
+  ROS_WARN_THROTTLE(options_.warn_throttle_s,
+                    "demodulator: %u raw batches lost in transport before %.6f s (sequence gap); "
+                    "%llu so far",
+                    batches, stamp.toSec(), static_cast<unsigned long long>(batches_lost_));
 }
 
 void DemodulatorNode::warnAboutDrops() {

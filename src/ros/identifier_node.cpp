@@ -77,6 +77,7 @@ IdentifierNode::IdentifierNode(const ros::NodeHandle& nh, const ros::NodeHandle&
   else
     data_sub_ = nh_.subscribe("sweep", options_.queue_size, &IdentifierNode::onSweep, this);
   truth_sub_ = nh_.subscribe("truth", 10, &IdentifierNode::onTruth, this);
+  loss_sub_ = nh_.subscribe("input_loss", 100, &IdentifierNode::onInputLoss, this);
   identify_srv_ = nh_.advertiseService("identify", &IdentifierNode::onIdentify, this);
   get_estimate_srv_ = nh_.advertiseService("get_estimate", &IdentifierNode::onGetEstimate, this);
   predict_drift_srv_ = nh_.advertiseService("predict_drift", &IdentifierNode::onPredictDrift, this);
@@ -112,6 +113,7 @@ void IdentifierNode::clearBuffer() {
   have_latest_ = false;
   new_data_since_identify_ = false;
   lost_gaps_.clear();
+  upstream_gaps_.clear();
   if (rls_) rls_->reset();
   rls_origin_ = ros::Time();
 }
@@ -177,6 +179,40 @@ uint64_t IdentifierNode::lostSince(const ros::Time& since) const {
   for (const auto& g : lost_gaps_)
     if (g.first > since) n += g.second;
   return n;
+}
+
+uint64_t IdentifierNode::upstreamLostSince(const ros::Time& since) const {
+  uint64_t n = 0;
+  for (const auto& g : upstream_gaps_)
+    if (g.first > since) n += g.second;
+  return n;
+}
+
+void IdentifierNode::onInputLoss(const InputLoss::ConstPtr& msg) {
+  upstream_batches_lost_ += msg->batches_lost;
+  upstream_gaps_.emplace_back(msg->header.stamp, msg->batches_lost);
+  ROS_WARN_THROTTLE(5.0, "identifier: %s: %u lost before %.6f s; estimates over that data will be "
+                         "marked suspect",
+                    msg->source.c_str(), msg->batches_lost, msg->header.stamp.toSec());
+}
+
+std::vector<std::string> IdentifierNode::estimateProblems() {
+  std::vector<std::string> problems = sanityProblems(estimate_);
+  // Gaps before the window's first sample no longer touch its data (a sliding window).
+  for (auto* gaps : {&lost_gaps_, &upstream_gaps_})
+    while (!gaps->empty() && !stamps_.empty() && gaps->front().first <= stamps_.front())
+      gaps->pop_front();
+  const uint64_t lost = lostSince(window_start_);
+  if (lost > 0)
+    problems.push_back(std::to_string(lost) +
+                       " input messages lost in transport (sequence gaps) within the data of "
+                       "this estimate");
+  const uint64_t upstream = upstreamLostSince(window_start_);
+  if (upstream > 0)
+    problems.push_back(std::to_string(upstream) +
+                       " raw batches lost upstream (the demodulator's input, sequence gaps) "
+                       "within the data of this estimate");
+  return problems;
 }
 
 void IdentifierNode::countSequence(uint32_t seq, const ros::Time& stamp) {
@@ -397,15 +433,7 @@ void IdentifierNode::publishEstimate() {
   msg.header.frame_id = options_.frame_id;
   msg.experiment_id = buffer_experiment_;
   msg.experiment_start = buffer_experiment_start_;
-  msg.sanity_problems = sanityProblems(estimate_);
-  // Gaps before the window's first sample no longer touch its data (a sliding window).
-  while (!lost_gaps_.empty() && !stamps_.empty() && lost_gaps_.front().first <= stamps_.front())
-    lost_gaps_.pop_front();
-  const uint64_t lost = lostSince(window_start_);
-  if (lost > 0)
-    msg.sanity_problems.push_back(std::to_string(lost) +
-                                  " input messages lost in transport (sequence gaps) within the "
-                                  "data of this estimate");
+  msg.sanity_problems = estimateProblems();
   msg.suspect = !msg.sanity_problems.empty();
   if (msg.suspect) {
     ++suspect_estimates_;
@@ -532,6 +560,10 @@ bool IdentifierNode::onIdentify(Identify::Request& req, Identify::Response& res)
     res.message = summary(estimate_, window_samples_);
     res.estimate = estimateToMsg(estimate_, window_start_, window_end_, window_samples_);
     res.estimate.header.frame_id = options_.frame_id;
+    res.estimate.experiment_id = buffer_experiment_;
+    res.estimate.experiment_start = buffer_experiment_start_;
+    res.estimate.sanity_problems = estimateProblems();
+    res.estimate.suspect = !res.estimate.sanity_problems.empty();
     res.derived = derivedToMsg(estimate_.derived, window_end_, estimate_.confidence,
                                o.identification.angular_gain_k);
   } catch (const std::exception& e) {
@@ -572,7 +604,7 @@ bool IdentifierNode::onGetEstimate(GetEstimate::Request& req, GetEstimate::Respo
     res.estimate.experiment_id = history_.back().estimate.experiment_id;
     res.estimate.experiment_start = history_.back().estimate.experiment_start;
   }
-  res.estimate.sanity_problems = sanityProblems(estimate_);
+  res.estimate.sanity_problems = estimateProblems();
   res.estimate.suspect = !res.estimate.sanity_problems.empty();
   res.derived = derivedToMsg(estimate_.derived, window_end_, estimate_.confidence,
                              options_.identification.angular_gain_k);
@@ -601,6 +633,7 @@ void IdentifierNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   stat.add("dropped_invalid", dropped_invalid_);
   stat.add("dropped_duplicate_stamp", dropped_duplicate_);
   stat.add("dropped_in_transport", dropped_transport_);
+  stat.add("upstream_batches_lost", upstream_batches_lost_);
   stat.add("trimmed_oldest", trimmed_);
   stat.add("buffer_depth", stamps_.size());
   stat.add("buffer_capacity", options_.max_samples);

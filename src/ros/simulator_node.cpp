@@ -226,7 +226,8 @@ void SimulatorNode::publishDueFreeDecay(double due_s) {
     if (due > raw_stream_->produced()) {
       const size_t cap = static_cast<size_t>(options_.max_batch_samples);
       if (due - raw_stream_->produced() > cap) ++capped_ticks_;
-      const RawRecord piece = raw_stream_->next(cap);
+      // What is due, no more (a full cap ran bursts up to a sixth of a second ahead of the clock).
+      const RawRecord piece = raw_stream_->next(std::min(cap, due - raw_stream_->produced()));
       RawSampleBatch batch =
           rawBatchToMsg(piece, 0, piece.size(), start_stamp_, preset_.raw_sample_rate_hz);
       batch.header.frame_id = options_.frame_id;

@@ -7,8 +7,9 @@ published; demodulator: a raw sample short implies a counted lost batch); the lo
 estimate covers every slow state the identifier kept and is checked against the simulator's truth
 (/cvg/truth): the true gamma lies inside the estimate's published interval [ci_low, ci_high], or the
 estimate is marked suspect with a reason naming input lost in transport (issue #27: nothing lost
-without a flag; raw batches the demodulator loses are counted in its diagnostics only and mark no
-estimate, which the JSON line's raw_loss_unflagged shows); with ~expect_lossless (the 1x run)
+without a flag; raw batches the demodulator loses reach the identifier as InputLoss events, and
+every raw loss must mark the final estimate suspect and be counted in the identifier's
+upstream_batches_lost); with ~expect_lossless (the 1x run)
 nothing may be lost at all and the estimate carries no lost-input reason; each node's peak RSS
 (VmHWM) stays under RSS_LIMIT_MB; a normal run afterwards is identified within 5 % of the true
 gamma with no new loss (recovery). Measured figures are printed (and appended as a JSON line to
@@ -41,7 +42,7 @@ MAX_BATCH = 50000  # config/simulator.yaml max_batch_samples
 def lost_input_reasons(est):
     """The estimate's reasons naming input lost on the way (identifier_node.cpp publishEstimate:
     "N input messages lost in transport (sequence gaps) within the data of this estimate")."""
-    return [p for p in est.sanity_problems if "lost in transport" in p]
+    return [p for p in est.sanity_problems if "lost in transport" in p or "lost upstream" in p]
 
 
 def truth_check(est, truth):
@@ -184,13 +185,18 @@ class LoadCheck(unittest.TestCase):
             "ident_dropped_in_transport": int(ident["dropped_in_transport"]),
             "peak_rss_mb": {k: round(v, 1) for k, v in rss.items()},
             "estimate": check,
-            # Raw batches the demodulator lost reach no estimate's reasons (only its diagnostics).
+            "ident_upstream_batches_lost": int(ident.get("upstream_batches_lost", -1)),
             "raw_loss_unflagged": bool(lost > 0 and not check["lost_input_flagged"]),
         }
         print("LOAD " + json.dumps(report))
         if os.environ.get("CVG_LOAD_REPORT"):
             with open(os.environ["CVG_LOAD_REPORT"], "a") as f:
                 f.write(json.dumps(report) + "\n")
+        # Every raw batch the demodulator lost reached the identifier and marks the estimate.
+        self.assertEqual(int(ident["upstream_batches_lost"]), lost, ident)
+        if lost > 0:
+            self.assertTrue(est.suspect and any("lost upstream" in p for p in est.sanity_problems),
+                            est.sanity_problems)
         if expect_lossless:
             self.assertEqual(int(ident["dropped_in_transport"]), 0, ident)
             self.assertEqual(lost, 0, demod)

@@ -37,11 +37,14 @@ class DemodulatorNode {
   void configure(double omega_rad_s, double sample_rate_hz);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   void warnAboutDrops();
+  /// Announces `batches` raw batches lost before `stamp` on input_loss (InputLoss.msg).
+  void publishLoss(uint32_t batches, const ros::Time& stamp);
 
   ros::NodeHandle nh_;
   DemodulatorNodeOptions options_;
   ros::Subscriber raw_sub_;
   ros::Publisher slow_pub_;
+  ros::Publisher loss_pub_;  ///< InputLoss events: raw batches missing (sequence gaps)
   ros::ServiceServer reset_srv_;
   diagnostic_updater::Updater diagnostics_;
   ros::WallTimer diagnostics_timer_;

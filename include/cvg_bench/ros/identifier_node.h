@@ -27,6 +27,7 @@
 #include "cvg_bench/Explain.h"
 #include "cvg_bench/GetEstimate.h"
 #include "cvg_bench/IdentifierConfig.h"
+#include "cvg_bench/InputLoss.h"
 #include "cvg_bench/Identify.h"
 #include "cvg_bench/ModelEstimate.h"
 #include "cvg_bench/PredictDrift.h"
@@ -62,6 +63,12 @@ class IdentifierNode {
   void countSequence(uint32_t seq, const ros::Time& stamp);
   /// Messages lost in transport among the data an estimate from `since` on uses.
   uint64_t lostSince(const ros::Time& since) const;
+  /// Raw batches the demodulator lost (InputLoss events) within the data from `since` on.
+  uint64_t upstreamLostSince(const ros::Time& since) const;
+  void onInputLoss(const InputLoss::ConstPtr& msg);
+  /// Why the current estimate is suspect: its sanity checks and any input lost within its data
+  /// (the published estimate and the services give the same list).
+  std::vector<std::string> estimateProblems();
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
   bool onIdentify(Identify::Request& req, Identify::Response& res);
   bool onGetEstimate(GetEstimate::Request& req, GetEstimate::Response& res);
@@ -123,6 +130,10 @@ class IdentifierNode {
   // back over a gap is published suspect with the count (issue #27). Gaps older than the buffer
   // are dropped as the window slides.
   std::deque<std::pair<ros::Time, uint64_t>> lost_gaps_;
+  // Raw batches lost upstream (the demodulator's InputLoss events), kept the same way.
+  std::deque<std::pair<ros::Time, uint64_t>> upstream_gaps_;
+  uint64_t upstream_batches_lost_ = 0;
+  ros::Subscriber loss_sub_;
   uint32_t last_seq_ = 0;
   uint64_t identifications_ = 0, identification_failures_ = 0, suspect_estimates_ = 0;
   double last_identify_wall_s_ = 0.0;
