@@ -98,7 +98,8 @@ def main(argv):
         rospy.loginfo("replay: %s left out: %s", t, why)
     for t, n in sorted(missing.items()):
         if n:
-            where = ("the demodulator counts the lost batches in its diagnostics" if t == RAW
+            where = ("the demodulator announces them (InputLoss) and the identifier marks "
+                     "estimates over them suspect" if t == RAW
                      else "the identifier marks estimates over them suspect")
             rospy.logwarn("replay: %s: %d messages missing by sequence number (the recording "
                           "dropped them); %s", t, n, where)
@@ -107,8 +108,10 @@ def main(argv):
         rospy.wait_for_service(service, 30.0)
     except rospy.ROSException:
         rospy.logwarn("replay: %s did not answer in 30 s; playing anyway", service)
+    # --wait-for-subscribers: the first batches are not sent before the demodulator (or the
+    # identifier) has subscribed; nothing counts a loss before a node's first message.
     cmd = ["rosbag", "play", "--clock", "--queue=%d" % QUEUE, "--rate=%g" % args.rate,
-           "--delay=%g" % args.delay]
+           "--delay=%g" % args.delay, "--wait-for-subscribers"]
     if args.loop == "true":
         cmd.append("--loop")
     cmd += [args.bag, "--topics"] + play
