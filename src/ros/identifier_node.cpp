@@ -191,8 +191,9 @@ uint64_t IdentifierNode::upstreamLostSince(const ros::Time& since) const {
 void IdentifierNode::onInputLoss(const InputLoss::ConstPtr& msg) {
   upstream_batches_lost_ += msg->batches_lost;
   upstream_gaps_.emplace_back(msg->header.stamp, msg->batches_lost);
-  ROS_WARN_THROTTLE(5.0, "identifier: %s: %u lost before %.6f s; estimates over that data will be "
-                         "marked suspect",
+  ROS_WARN_THROTTLE(5.0,
+                    "identifier: %s: %u lost before %.6f s; estimates over that data will be "
+                    "marked suspect",
                     msg->source.c_str(), msg->batches_lost, msg->header.stamp.toSec());
 }
 

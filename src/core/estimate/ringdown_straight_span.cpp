@@ -116,7 +116,8 @@ StraightSpan findStraightSpan(const std::vector<double>& t, const std::vector<do
     // The last sample of each run within peak_near_db of the top, in time order.
     peaks.clear();
     for (size_t i = 0; i + hw < m; ++i)
-      if (wide[i] >= wide[ip] - o.peak_near_db && !(i + 1 + hw < m && wide[i + 1] >= wide[ip] - o.peak_near_db))
+      if (wide[i] >= wide[ip] - o.peak_near_db &&
+          !(i + 1 + hw < m && wide[i + 1] >= wide[ip] - o.peak_near_db))
         peaks.push_back(i);
   }
   // 2-3. Candidates from falls below the peak(s).

@@ -1,12 +1,12 @@
 // Known-answer tests of the ring-down segmentation and fit on records of the ring-down generator.
 #include "cvg_bench/core/estimate/ringdown_fit.h"
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/ringdown_simulator.h"
 
@@ -183,7 +183,6 @@ TEST(RingdownFit, AmplitudeLawQIsTheSpansMeanDecay) {
   EXPECT_NEAR(q / line.derived.at("Q").value, 1.0, 0.03);
   EXPECT_GT(law.derived.at("Q").std, 0.0);
 }
-
 
 // A decay that bends into a floor that wanders fast, the record ending 3 dB under the floor's
 // level (too little floor to confirm one): the span must end above the bend (here the suspected

@@ -75,7 +75,6 @@ TEST(RingdownStraightSpan, NoDecayIsNoStretch) {
   EXPECT_FALSE(findStraightSpan(r.t, r.y, r.skip).ok);
 }
 
-
 // A decay followed by the drive on again to the record's end (the development set's D309 shape):
 // from the highest peak (the last stretch) nothing falls; all_peaks finds the decay after the
 // first stretch.

@@ -4,9 +4,10 @@
 //     median of 1/300 of them (a switch-off transient of ten samples stays visible); its robust
 //     sample-to-sample sd sets the tolerance tol = max(tol_db, 4 sd).
 //  2. From each start where the level first falls 1, 2, 3, 5, 8, 12, 17, 23, 30 or 40 dB below
-//     its peak (or each of its peaks with all_peaks), the first `first_db` of fall must lie on a line within tol; the line is then
-//     extended sample by sample (refitted every tenth of its length) until `run` consecutive
-//     samples (1 % of the grid, at least 3) leave it by more than tol.
+//     its peak (or each of its peaks with all_peaks), the first `first_db` of fall must lie on a
+//     line within tol; the line is then extended sample by sample (refitted every tenth of its
+//     length) until `run` consecutive samples (1 % of the grid, at least 3) leave it by more than
+//     tol.
 //  3. The candidate with the largest fall in dB times the square root of its samples wins (an
 //     earlier start wins ties within 5 %): a long decay, not a switch-off transient of a few
 //     samples that falls as many dB.
