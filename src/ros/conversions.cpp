@@ -48,9 +48,19 @@ RawSamples rawSamplesFromMsg(const RawSampleBatch& msg, const ros::Time& origin)
   out.g = msg.g;
   out.t_s.resize(n);
   const double t0 = secondsSince(msg.header.stamp, origin);
-  const double dt = irregular ? 0.0 : 1.0 / msg.sample_rate_hz;
+  if (irregular) {
+    for (size_t i = 0; i < n; ++i) out.t_s[i] = t0 + msg.time_offsets_s[i];
+    return out;
+  }
+  // A stamp is a whole nanosecond: a uniform batch whose first sample lies within 1 ns of the
+  // sample grid counted from the origin is put on that grid, sample k at k / rate, so the times
+  // do not depend on where a publisher cut its batches (issue #27: two live runs, one record).
+  const double rate = msg.sample_rate_hz;
+  const double k0 = std::round(t0 * rate);
+  const bool on_grid = rate < 1e8 && std::fabs(t0 - k0 / rate) <= 1e-9 && std::fabs(k0) < 1e15;
   for (size_t i = 0; i < n; ++i)
-    out.t_s[i] = t0 + (irregular ? msg.time_offsets_s[i] : static_cast<double>(i) * dt);
+    out.t_s[i] =
+        on_grid ? (k0 + static_cast<double>(i)) / rate : t0 + static_cast<double>(i) / rate;
   return out;
 }
 

@@ -78,11 +78,16 @@ IdentifierNode::IdentifierNode(const ros::NodeHandle& nh, const ros::NodeHandle&
     data_sub_ = nh_.subscribe("sweep", options_.queue_size, &IdentifierNode::onSweep, this);
   truth_sub_ = nh_.subscribe("truth", 10, &IdentifierNode::onTruth, this);
   loss_sub_ = nh_.subscribe("input_loss", 100, &IdentifierNode::onInputLoss, this);
-  identify_srv_ = nh_.advertiseService("identify", &IdentifierNode::onIdentify, this);
-  get_estimate_srv_ = nh_.advertiseService("get_estimate", &IdentifierNode::onGetEstimate, this);
-  predict_drift_srv_ = nh_.advertiseService("predict_drift", &IdentifierNode::onPredictDrift, this);
-  reset_srv_ = nh_.advertiseService("identifier/reset", &IdentifierNode::onReset, this);
-  explain_srv_ = nh_.advertiseService("explain", &IdentifierNode::onExplain, this);
+  // Services on their own thread: a solve they ask for does not hold up the data callbacks.
+  ros::NodeHandle services(nh_);
+  services.setCallbackQueue(&service_queue_);
+  identify_srv_ = services.advertiseService("identify", &IdentifierNode::onIdentify, this);
+  get_estimate_srv_ =
+      services.advertiseService("get_estimate", &IdentifierNode::onGetEstimate, this);
+  predict_drift_srv_ =
+      services.advertiseService("predict_drift", &IdentifierNode::onPredictDrift, this);
+  reset_srv_ = services.advertiseService("identifier/reset", &IdentifierNode::onReset, this);
+  explain_srv_ = services.advertiseService("explain", &IdentifierNode::onExplain, this);
   timer_ = nh_.createWallTimer(ros::WallDuration(0.05), &IdentifierNode::onTimer, this);
   reconfigure_.reset(new dynamic_reconfigure::Server<IdentifierConfig>(pnh));
   reconfigure_->setCallback(
@@ -92,8 +97,15 @@ IdentifierNode::IdentifierNode(const ros::NodeHandle& nh, const ros::NodeHandle&
   last_diag_wall_ = ros::WallTime::now();
   diagnostics_timer_ = nh_.createWallTimer(
       ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { diagnostics_.force_update(); });
+  service_spinner_.reset(new ros::AsyncSpinner(1, &service_queue_));
+  service_spinner_->start();
   ROS_INFO("identifier: %s, model %s, method %s", options_.mode.c_str(),
            options_.identification.model.c_str(), options_.identification.method.c_str());
+}
+
+IdentifierNode::~IdentifierNode() {
+  if (service_spinner_) service_spinner_->stop();
+  if (background_.valid()) background_.wait();
 }
 
 double IdentifierNode::omegaForEstimate() const {
@@ -107,6 +119,7 @@ void IdentifierNode::clearData(const std::string& why) {
 }
 
 void IdentifierNode::clearBuffer() {
+  ++generation_;
   stamps_.clear();
   slow_q_.clear();
   sweep_ = SweepRecord();
@@ -119,6 +132,7 @@ void IdentifierNode::clearBuffer() {
 }
 
 void IdentifierNode::onTruth(const SimulationTruth::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
   if (msg->mode != options_.mode && truth_mode_warned_ != msg->mode) {
     truth_mode_warned_ = msg->mode;
     ROS_WARN(
@@ -133,6 +147,7 @@ void IdentifierNode::onTruth(const SimulationTruth::ConstPtr& msg) {
 }
 
 void IdentifierNode::onReconfigure(IdentifierConfig& c, uint32_t) {
+  std::lock_guard<std::mutex> lock(mutex_);
   IdentifierNodeOptions next = options_;
   next.identification.model = c.model;
   next.identification.method = c.method;
@@ -160,6 +175,7 @@ void IdentifierNode::onReconfigure(IdentifierConfig& c, uint32_t) {
                      next.window_s != options_.window_s;
   options_ = next;
   if (!refit) return;
+  ++generation_;  // a solve in flight used the old settings
   rls_.reset(options_.identification.method == "rls"
                  ? new StreamingFreeDecayRls(options_.identification)
                  : nullptr);
@@ -189,6 +205,7 @@ uint64_t IdentifierNode::upstreamLostSince(const ros::Time& since) const {
 }
 
 void IdentifierNode::onInputLoss(const InputLoss::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
   upstream_batches_lost_ += msg->batches_lost;
   upstream_gaps_.emplace_back(msg->header.stamp, msg->batches_lost);
   ROS_WARN_THROTTLE(5.0,
@@ -262,6 +279,7 @@ void IdentifierNode::trackExperiment(const ros::Time& epoch, const ros::Time& st
 }
 
 void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
   countSequence(msg->header.seq, msg->header.stamp);
   Eigen::Vector4d q;
   try {
@@ -325,6 +343,7 @@ void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
 }
 
 void IdentifierNode::onSweep(const SweepPoint::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
   const ros::Time stamp = msg->header.stamp;
   countSequence(msg->header.seq, msg->header.stamp);
   trackExperiment(ros::Time(), stamp);
@@ -367,49 +386,117 @@ SlowRecord IdentifierNode::bufferedSlowRecord() const {
   return rec;
 }
 
-void IdentifierNode::identifyNow(const IdentificationOptions& options) {
+PipelineOptions IdentifierNode::periodicOptions() const {
   // The window's batch estimate is the honest least-squares one (in `rls` mode the same z at
   // forgetting 1 as the streaming estimate, docs/paper.md item 9, with honest intervals).
   PipelineOptions batch;
   batch.method = Method::kLs;
+  batch.identification = options_.identification;
+  return batch;
+}
+
+void IdentifierNode::identifyNow(const IdentificationOptions& options) {
+  PipelineOptions batch = periodicOptions();
   batch.identification = options;
   identifyNow(batch);
 }
 
-void IdentifierNode::identifyNow(const PipelineOptions& options) {
+IdentifierNode::SolveInput IdentifierNode::snapshot(const PipelineOptions& options) const {
   const int have = static_cast<int>(stamps_.size());
   if (have < options_.min_samples)
     throw InputError("only " + std::to_string(have) +
                      (mode_ == ExperimentMode::kFreeDecay ? " slow states" : " sweep points") +
                      " buffered; min_samples is " + std::to_string(options_.min_samples));
+  SolveInput in;
+  if (mode_ == ExperimentMode::kFreeDecay)
+    in.slow = bufferedSlowRecord();
+  else
+    in.sweep = sweep_;
+  in.options = options;
+  in.start = stamps_.front();
+  in.end = stamps_.back();
+  in.samples = static_cast<uint32_t>(have);
+  in.generation = generation_;
+  in.identifications_before = identifications_;
+  return in;
+}
+
+Estimate IdentifierNode::solve(const SolveInput& in) const {
+  return mode_ == ExperimentMode::kFreeDecay ? identify(in.slow, in.options)
+                                             : identify(in.sweep, in.options);
+}
+
+void IdentifierNode::acceptEstimate(const Estimate& e, const SolveInput& in, double wall_s) {
+  last_identify_wall_s_ = wall_s;
+  ++identifications_;  // a solve still in flight is older than this estimate
+  last_solver_message_ = summary(e, in.samples);
+  estimate_ = e;
+  window_start_ = in.start;
+  window_end_ = in.end;
+  window_samples_ = in.samples;
+  have_estimate_ = true;
+  axes_pending_ = true;
+  if (e.rank < e.n_params)
+    ROS_WARN("identifier: %s", summary(e, in.samples).c_str());
+  else
+    ROS_INFO("identifier: %s", summary(e, in.samples).c_str());
+  publishEstimate();
+}
+
+void IdentifierNode::identifyNow(const PipelineOptions& options) {
+  const SolveInput in = snapshot(options);
   const ros::WallTime t0 = ros::WallTime::now();
   Estimate e;
   try {
-    e = mode_ == ExperimentMode::kFreeDecay ? identify(bufferedSlowRecord(), options)
-                                            : identify(sweep_, options);
+    e = solve(in);
   } catch (const std::exception& ex) {
     ++identification_failures_;
     last_solver_message_ = std::string("failed: ") + ex.what();
     throw;
   }
-  last_identify_wall_s_ = (ros::WallTime::now() - t0).toSec();
-  ++identifications_;
-  last_solver_message_ = summary(e, have);
-  estimate_ = e;
-  window_start_ = stamps_.front();
-  window_end_ = stamps_.back();
-  window_samples_ = static_cast<uint32_t>(have);
-  have_estimate_ = true;
-  axes_pending_ = true;
   new_data_since_identify_ = false;
-  if (e.rank < e.n_params)
-    ROS_WARN("identifier: %s", summary(e, have).c_str());
-  else
-    ROS_INFO("identifier: %s", summary(e, have).c_str());
-  publishEstimate();
+  acceptEstimate(e, in, (ros::WallTime::now() - t0).toSec());
+}
+
+void IdentifierNode::startBackgroundSolve() {
+  try {
+    background_input_ = snapshot(periodicOptions());
+  } catch (const std::exception& e) {
+    ROS_WARN("identifier: identification failed: %s", e.what());
+    return;
+  }
+  background_started_ = ros::WallTime::now();
+  const SolveInput* in = &background_input_;  // not touched again until the result is taken
+  background_ = std::async(std::launch::async, [this, in] { return solve(*in); });
+}
+
+void IdentifierNode::collectBackgroundSolve() {
+  if (!background_.valid() ||
+      background_.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+    return;
+  const double wall_s = (ros::WallTime::now() - background_started_).toSec();
+  Estimate e;
+  try {
+    e = background_.get();
+  } catch (const std::exception& ex) {
+    ++identification_failures_;
+    last_solver_message_ = std::string("failed: ") + ex.what();
+    ROS_WARN("identifier: identification failed: %s", ex.what());
+    return;
+  }
+  if (background_input_.generation != generation_ ||
+      background_input_.identifications_before != identifications_) {
+    ++stale_solves_;  // the buffer changed, or a newer estimate came, while it ran
+    ROS_DEBUG("identifier: a solve of a buffer that has changed since was discarded");
+    return;
+  }
+  acceptEstimate(e, background_input_, wall_s);
 }
 
 void IdentifierNode::onTimer(const ros::WallTimerEvent&) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  collectBackgroundSolve();
+  if (background_.valid()) return;  // one solve at a time; data that came meanwhile go next
   const ros::WallTime now = ros::WallTime::now();
   bool run = false;
   if (options_.identify_period_s > 0.0 && new_data_since_identify_ &&
@@ -422,11 +509,7 @@ void IdentifierNode::onTimer(const ros::WallTimerEvent&) {
     run = true;
   if (!run) return;
   new_data_since_identify_ = false;  // one attempt per batch of new data
-  try {
-    identifyNow(options_.identification);
-  } catch (const std::exception& e) {
-    ROS_WARN("identifier: identification failed: %s", e.what());
-  }
+  startBackgroundSolve();
 }
 
 void IdentifierNode::publishEstimate() {
@@ -549,14 +632,35 @@ void IdentifierNode::publishMarkers() {
 
 bool IdentifierNode::onIdentify(Identify::Request& req, Identify::Response& res) {
   // Every method of the pipeline: ls, rls (batch recursive (2.12)) and ceres (output error).
-  PipelineOptions o;
-  o.identification = options_.identification;
-  if (!req.model.empty()) o.identification.model = req.model;
-  if (req.confidence != 0.0) o.identification.confidence = req.confidence;
+  // Solved on the service thread outside the lock; the buffer goes on filling meanwhile.
   try {
-    o.method = parseMethod(req.method.empty() ? options_.identification.method : req.method);
-    throwIfProblems("identify request", o.validate());
-    identifyNow(o);
+    SolveInput in;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      PipelineOptions o;
+      o.identification = options_.identification;
+      if (!req.model.empty()) o.identification.model = req.model;
+      if (req.confidence != 0.0) o.identification.confidence = req.confidence;
+      o.method = parseMethod(req.method.empty() ? options_.identification.method : req.method);
+      throwIfProblems("identify request", o.validate());
+      in = snapshot(o);
+    }
+    const ros::WallTime t0 = ros::WallTime::now();
+    Estimate e;
+    try {
+      e = solve(in);
+    } catch (const std::exception& ex) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++identification_failures_;
+      last_solver_message_ = std::string("failed: ") + ex.what();
+      throw;
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (in.generation != generation_)
+      throw InputError(
+          "the buffer was cleared or the settings changed while identifying (a new experiment, a "
+          "reset or a reconfiguration): call identify again");
+    acceptEstimate(e, in, (ros::WallTime::now() - t0).toSec());
     res.success = estimate_.rank == estimate_.n_params;
     res.message = summary(estimate_, window_samples_);
     res.estimate = estimateToMsg(estimate_, window_start_, window_end_, window_samples_);
@@ -566,7 +670,7 @@ bool IdentifierNode::onIdentify(Identify::Request& req, Identify::Response& res)
     res.estimate.sanity_problems = estimateProblems();
     res.estimate.suspect = !res.estimate.sanity_problems.empty();
     res.derived = derivedToMsg(estimate_.derived, window_end_, estimate_.confidence,
-                               o.identification.angular_gain_k);
+                               in.options.identification.angular_gain_k);
   } catch (const std::exception& e) {
     res.success = false;
     res.message = e.what();
@@ -575,6 +679,7 @@ bool IdentifierNode::onIdentify(Identify::Request& req, Identify::Response& res)
 }
 
 bool IdentifierNode::onGetEstimate(GetEstimate::Request& req, GetEstimate::Response& res) {
+  std::lock_guard<std::mutex> lock(mutex_);
   if (req.experiment_id != 0) {
     for (const StoredEstimate& h : history_)
       if (h.estimate.experiment_id == req.experiment_id) {
@@ -613,6 +718,7 @@ bool IdentifierNode::onGetEstimate(GetEstimate::Request& req, GetEstimate::Respo
 }
 
 void IdentifierNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
+  std::lock_guard<std::mutex> lock(mutex_);
   const ros::WallTime now = ros::WallTime::now();
   const double dt = (now - last_diag_wall_).toSec();
   const double rate = dt > 0.0 ? (received_ - received_at_last_diag_) / dt : 0.0;
@@ -643,6 +749,8 @@ void IdentifierNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   stat.add("identifications", identifications_);
   stat.add("identification_failures", identification_failures_);
   stat.add("last_identification_wall_s", last_identify_wall_s_);
+  stat.add("solving", background_.valid());
+  stat.add("stale_solves_discarded", stale_solves_);
   stat.add("solver", last_solver_message_);
   stat.add("suspect_estimates", suspect_estimates_);
   for (size_t i = 0; i < last_sanity_problems_.size(); ++i)
@@ -650,6 +758,7 @@ void IdentifierNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
 }
 
 bool IdentifierNode::onPredictDrift(PredictDrift::Request& req, PredictDrift::Response& res) {
+  std::lock_guard<std::mutex> lock(mutex_);
   try {
     if (!have_estimate_) throw InputError("no estimate yet: call identify first");
     double r = req.r, k = req.k, theta = req.theta_rad;
@@ -689,6 +798,7 @@ bool IdentifierNode::onPredictDrift(PredictDrift::Request& req, PredictDrift::Re
 }
 
 bool IdentifierNode::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
+  std::lock_guard<std::mutex> lock(mutex_);
   clearData("reset requested");
   have_estimate_ = false;
   estimate_ = Estimate();
@@ -704,15 +814,16 @@ bool IdentifierNode::onExplain(Explain::Request& req, Explain::Response& res) {
       throw InputError("this identifier buffers " + experimentModeName(mode_) + " data, not " +
                        experimentModeName(mode));
     ExplainOptions eo;
-    eo.fitting.identification = options_.identification;
-    if (eo.fitting.identification.method == "rls") eo.fitting.identification.method = "ls";
-    const int have = static_cast<int>(stamps_.size());
-    if (have < options_.min_samples)
-      throw InputError("only " + std::to_string(have) + " samples buffered; min_samples is " +
-                       std::to_string(options_.min_samples));
-    const Explanation ex = mode_ == ExperimentMode::kFreeDecay
-                               ? explainFreeDecay(bufferedSlowRecord(), eo)
-                               : explainForced(sweep_, eo);
+    SolveInput in;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      eo.fitting.identification = options_.identification;
+      if (eo.fitting.identification.method == "rls") eo.fitting.identification.method = "ls";
+      in = snapshot(PipelineOptions());
+    }
+    // Explained on the service thread outside the lock: the data callbacks go on meanwhile.
+    const Explanation ex = mode_ == ExperimentMode::kFreeDecay ? explainFreeDecay(in.slow, eo)
+                                                               : explainForced(in.sweep, eo);
     std::string selected;
     for (const auto& s : ex.selection.selected) selected += (selected.empty() ? "" : "+") + s;
     res.success = true;

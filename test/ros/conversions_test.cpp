@@ -46,6 +46,30 @@ TEST(Conversions, UniformRawBatchRoundTrip) {
   }
 }
 
+TEST(Conversions, UniformBatchTimesDoNotDependOnWhereBatchesAreCut) {
+  // Issue #27: a stamp holds whole nanoseconds; a batch cut at another sample must give the very
+  // same sample times (k / rate from the origin), not the rounded stamp plus i / rate.
+  const double rate = 48000.0;
+  RawRecord rec;
+  for (int i = 0; i < 100000; ++i) {
+    rec.t_s.push_back(i / rate);
+    rec.f.push_back(0.0);
+    rec.g.push_back(0.0);
+  }
+  const ros::Time origin(1700000000, 123456789);
+  for (size_t begin : {1u, 7u, 3001u, 77777u}) {
+    const RawSamples s =
+        rawSamplesFromMsg(rawBatchToMsg(rec, begin, begin + 50, origin, rate), origin);
+    for (size_t i = 0; i < 50; ++i) EXPECT_EQ(s.t_s[i], rec.t_s[begin + i]) << begin << " " << i;
+  }
+  // A stamp off the sample grid by more than its rounding (a real publisher's jitter) is kept.
+  RawSampleBatch msg = rawBatchToMsg(rec, 10, 12, origin, rate);
+  msg.header.stamp += ros::Duration(0, 3000);
+  const RawSamples s = rawSamplesFromMsg(msg, origin);
+  EXPECT_NEAR(s.t_s[0], rec.t_s[10] + 3e-6, 1e-9);  // the stamp's own rounding
+  EXPECT_NEAR(s.t_s[1] - s.t_s[0], 1.0 / rate, 1e-15);
+}
+
 TEST(Conversions, IrregularRawBatchKeepsOffsets) {
   RawRecord rec;
   rec.t_s = {0.0, 0.001, 0.0035, 0.004};

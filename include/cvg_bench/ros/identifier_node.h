@@ -11,16 +11,29 @@
 // history_size experiments' estimates stay retrievable (get_estimate by experiment_id). Every
 // published estimate carries its experiment id and its sanity problems (estimate_sanity.h).
 // Diagnostics (1 Hz): input rate, drops by reason, buffer depth, experiment, solver state.
+//
+// Threads (issue #27): the data callbacks only buffer (O(1) per message). The periodic and
+// end-of-data solves run on a worker thread from a snapshot of the buffer, one at a time; the
+// timer publishes the result when it is ready, unless the buffer changed meanwhile (new
+// experiment, reset, refit settings, or a newer estimate), when it is discarded and counted. The
+// services run on their own callback thread and solve (identify, explain) outside the state
+// lock, so neither a solve nor a service call holds up the incoming data. Only the finishing
+// estimate of an experiment, when the next one starts before it was solved, is solved on the
+// data thread (once per experiment).
 #pragma once
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
+#include <ros/spinner.h>
 #include <std_srvs/Trigger.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <deque>
+#include <future>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "cvg_bench/DerivedQuantitiesStamped.h"
@@ -47,8 +60,31 @@ class IdentifierNode {
  public:
   /// Reads the settings from pnh; throws InputError listing every problem.
   IdentifierNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh);
+  /// Stops the service thread and waits for a solve in flight.
+  ~IdentifierNode();
 
  private:
+  /// What one solve needs, copied from the buffer under the lock.
+  struct SolveInput {
+    SlowRecord slow;
+    SweepRecord sweep;
+    PipelineOptions options;
+    ros::Time start, end;
+    uint32_t samples = 0;
+    uint64_t generation = 0;              ///< generation_ at the snapshot
+    uint64_t identifications_before = 0;  ///< identifications_ at the snapshot
+  };
+  /// Snapshot of the buffer for a solve; InputError below min_samples. Caller holds mutex_.
+  SolveInput snapshot(const PipelineOptions& options) const;
+  /// The core's identification of a snapshot (no node state: runs on any thread).
+  Estimate solve(const SolveInput& in) const;
+  /// Stores a solve's estimate as the current one and publishes it. Caller holds mutex_.
+  void acceptEstimate(const Estimate& e, const SolveInput& in, double wall_s);
+  /// Starts the periodic / end-of-data solve on the worker. Caller holds mutex_.
+  void startBackgroundSolve();
+  /// Publishes the worker's result when ready (or counts it stale). Caller holds mutex_.
+  void collectBackgroundSolve();
+
   void onSlow(const SlowState::ConstPtr& msg);
   void onSweep(const SweepPoint::ConstPtr& msg);
   void onTruth(const SimulationTruth::ConstPtr& msg);
@@ -83,6 +119,8 @@ class IdentifierNode {
   /// The same by batch LS (periodic and end-of-data runs; in `rls` mode the recursive estimate
   /// streams already).
   void identifyNow(const IdentificationOptions& options);
+  /// Batch LS options of the periodic and end-of-data solves.
+  PipelineOptions periodicOptions() const;
   void clearData(const std::string& why);
   void clearBuffer();
   /// The buffered window as a core record (t from the first buffered stamp).
@@ -168,6 +206,17 @@ class IdentifierNode {
   Estimate estimate_;
   ros::Time window_start_, window_end_;
   uint32_t window_samples_ = 0;
+
+  // Threads: every callback holds mutex_ while it touches the state above. generation_ changes
+  // whenever a solve in flight would no longer describe the buffer (cleared, refit settings).
+  std::mutex mutex_;
+  uint64_t generation_ = 0;
+  std::future<Estimate> background_;
+  SolveInput background_input_;
+  ros::WallTime background_started_;
+  uint64_t stale_solves_ = 0;
+  ros::CallbackQueue service_queue_;
+  std::unique_ptr<ros::AsyncSpinner> service_spinner_;
 };
 
 }  // namespace cvg_bench
