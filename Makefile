@@ -13,7 +13,7 @@ export CCACHE_BASEDIR := $(CURDIR)
 export CCACHE_NOHASHDIR := 1
 endif
 
-.PHONY: deps build demo test bench format clean
+.PHONY: deps build install demo test bench format clean
 
 deps:
 	@bash scripts/install_deps.sh
@@ -35,6 +35,12 @@ build: deps
 	@cd $(WS) && catkin_make --source .src $(CATKIN_ARGS) -j$(JOBS) > ../catkin_build.log 2>&1 \
 	  || { tail -n 60 ../catkin_build.log; echo "make build: failed (full log: build/catkin_build.log)"; exit 1; }
 	@echo "make build: ok (tool: bin/cvg_ident)"
+
+# The install space build/ws/install (README "Install space").
+install: build
+	@cd $(WS) && catkin_make --source .src $(CATKIN_ARGS) -j$(JOBS) install > ../catkin_install.log 2>&1 \
+	  || { tail -n 60 ../catkin_install.log; echo "make install: failed (full log: build/catkin_install.log)"; exit 1; }
+	@echo "make install: ok (source build/ws/install/setup.bash)"
 
 demo: build
 	@bash scripts/demo.sh
