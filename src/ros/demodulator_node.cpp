@@ -49,17 +49,22 @@ void DemodulatorNode::configure(double omega_rad_s, double sample_rate_hz) {
       demodulator_->latencyS());
 }
 
-void DemodulatorNode::resetState(const std::string& why) {
+void DemodulatorNode::resetState(const std::string& why, bool expected) {
   if (demodulator_) demodulator_->reset();
   have_epoch_ = false;
   last_end_ = ros::Time();
   ++node_resets_;
   last_problem_ = why;
-  ROS_WARN("demodulator reset: %s", why.c_str());
+  // A rerun or a requested reset is normal bench work (INFO); a jump back in time is not (issue
+  // #27).
+  if (expected)
+    ROS_INFO("demodulator reset: %s", why.c_str());
+  else
+    ROS_WARN("demodulator reset: %s", why.c_str());
 }
 
 bool DemodulatorNode::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
-  resetState("reset requested");
+  resetState("reset requested", true);
   res.success = true;
   res.message = "demodulator reset";
   return true;
@@ -103,9 +108,9 @@ void DemodulatorNode::onRaw(const RawSampleBatch::ConstPtr& msg) {
   }
   const ros::Time epoch = msg->phase_epoch.isZero() ? msg->header.stamp : msg->phase_epoch;
   if (have_epoch_ && !msg->phase_epoch.isZero() && msg->phase_epoch != epoch_)
-    resetState("new phase epoch (a new experiment started)");
+    resetState("new phase epoch (a new experiment started)", true);
   else if (have_epoch_ && secondsSince(msg->header.stamp, last_end_) < -options_.backward_jump_s)
-    resetState("data jumped back in time (bag loop?)");
+    resetState("data jumped back in time (bag loop?)", false);
   if (!have_epoch_) {
     epoch_ = epoch;
     have_epoch_ = true;

@@ -120,6 +120,7 @@ void IdentifierNode::clearData(const std::string& why) {
 
 void IdentifierNode::clearBuffer() {
   ++generation_;
+  last_axes_stamp_ = ros::Time();  // a bag loop's experiment may start earlier in time
   stamps_.clear();
   slow_q_.clear();
   sweep_ = SweepRecord();
@@ -315,6 +316,7 @@ void IdentifierNode::onSlow(const SlowState::ConstPtr& msg) {
   latest_stamp_ = stamp;
   have_latest_ = true;
   last_data_wall_ = ros::WallTime::now();
+  finished_ = false;
   new_data_since_identify_ = true;
 
   if (rls_) {
@@ -370,6 +372,7 @@ void IdentifierNode::onSweep(const SweepPoint::ConstPtr& msg) {
   latest_stamp_ = stamp;
   have_latest_ = true;
   last_data_wall_ = ros::WallTime::now();
+  finished_ = false;
   new_data_since_identify_ = true;
   publishFrames();
 }
@@ -436,6 +439,9 @@ void IdentifierNode::acceptEstimate(const Estimate& e, const SolveInput& in, dou
   window_samples_ = in.samples;
   have_estimate_ = true;
   axes_pending_ = true;
+  // The end-of-data estimate of the whole buffer: the experiment is finished (panel, diagnostics).
+  finished_ = options_.idle_identify_s > 0.0 && in.samples == stamps_.size() &&
+              (ros::WallTime::now() - last_data_wall_).toSec() >= options_.idle_identify_s;
   if (e.rank < e.n_params)
     ROS_WARN("identifier: %s", summary(e, in.samples).c_str());
   else
@@ -459,6 +465,8 @@ void IdentifierNode::identifyNow(const PipelineOptions& options) {
 }
 
 void IdentifierNode::startBackgroundSolve() {
+  // Too few states yet (the start of a run or a rerun) is normal: the next period tries again.
+  if (static_cast<int>(stamps_.size()) < options_.min_samples) return;
   try {
     background_input_ = snapshot(periodicOptions());
   } catch (const std::exception& e) {
@@ -553,7 +561,37 @@ void IdentifierNode::publishEstimate() {
       }
     }
   }
+  updateWindowDrift();
   publishFrames();
+}
+
+void IdentifierNode::updateWindowDrift() {
+  // The rviz headline (issue #27): theta' of the estimate averaged over the buffered states whose
+  // amplitude is above 10 % of the largest (near r = k the instantaneous (5.9) swings widely); at
+  // most 200 evenly spaced states keep the delta method cheap.
+  have_window_drift_ = false;
+  if (mode_ != ExperimentMode::kFreeDecay || slow_q_.empty()) return;
+  std::vector<OrbitElements> all;
+  all.reserve(slow_q_.size());
+  double r_max = 0.0;
+  for (const Eigen::Vector4d& q : slow_q_) {
+    all.push_back(orbitFromSlow(q));
+    r_max = std::max(r_max, std::fabs(all.back().r));
+  }
+  std::vector<OrbitElements> kept;
+  for (const OrbitElements& o : all)
+    if (std::fabs(o.r) > 0.1 * r_max && std::fabs(o.r * o.r - o.k * o.k) > 1e-12 * o.r * o.r)
+      kept.push_back(o);
+  if (kept.empty()) return;
+  std::vector<OrbitElements> used;
+  const std::size_t step = (kept.size() + 199) / 200;
+  for (std::size_t i = 0; i < kept.size(); i += step) used.push_back(kept[i]);
+  try {
+    window_drift_rad_s_ = meanDriftRateWithInterval(used, uncertainParameters(estimate_));
+    have_window_drift_ = true;
+  } catch (const std::exception& e) {
+    ROS_DEBUG("identifier: no window drift: %s", e.what());
+  }
 }
 
 void IdentifierNode::publishFrames() {
@@ -569,9 +607,14 @@ void IdentifierNode::publishFrames() {
   const std::string& parent = options_.frame_id;
   const std::string& prefix = options_.child_frame_prefix;
   if (have_estimate_) {
+    // Two estimates at one data stamp (the last periodic one and the end-of-data one) would repeat
+    // the axes' stamp (TF_REPEATED_DATA in every listener): the second goes 1 ns later.
+    const ros::Time axes_stamp =
+        stamp > last_axes_stamp_ ? stamp : last_axes_stamp_ + ros::Duration(0, 1);
+    last_axes_stamp_ = axes_stamp;
     const DefectAxes axes = defectAxes(valuesOf(estimate_));
-    frames.push_back(rotationAboutZ(parent, prefix + "stiffness_axis", axes.alpha, stamp));
-    frames.push_back(rotationAboutZ(parent, prefix + "damping_axis", axes.beta, stamp));
+    frames.push_back(rotationAboutZ(parent, prefix + "stiffness_axis", axes.alpha, axes_stamp));
+    frames.push_back(rotationAboutZ(parent, prefix + "damping_axis", axes.beta, axes_stamp));
     axes_pending_ = false;
   }
   last_tf_wall_ = now;
@@ -612,14 +655,20 @@ void IdentifierNode::publishMarkers() {
       t << label << " = " << it->second.value * scale << " [" << it->second.ci_low * scale << ", "
         << it->second.ci_high * scale << "]" << unit << "\n";
     };
-    t << "experiment " << buffer_experiment_ << ", " << window_samples_ << " samples, "
+    t << nh_.getNamespace() << ": experiment " << buffer_experiment_
+      << (finished_ ? " finished: final estimate, " : ", ") << window_samples_ << " samples, "
       << estimate_.method << " " << estimate_.model << "\n";
     line("Q", "Q", 1.0, "");
     line("split", "frequency_split_hz", 1.0, " Hz");
+    constexpr double kDegPerHour = 180.0 / M_PI * 3600.0;  // from rad/s
+    if (have_window_drift_)
+      t << "drift (window mean) = " << window_drift_rad_s_.value * kDegPerHour << " ["
+        << window_drift_rad_s_.ci_low * kDegPerHour << ", "
+        << window_drift_rad_s_.ci_high * kDegPerHour << "] deg/h\n";
     if (have_drift_)
-      t << "drift = " << last_drift_rad_s_.value * 180 / M_PI << " ["
-        << last_drift_rad_s_.ci_low * 180 / M_PI << ", " << last_drift_rad_s_.ci_high * 180 / M_PI
-        << "] deg/s\n";
+      t << "  now: " << last_drift_rad_s_.value * kDegPerHour << " ["
+        << last_drift_rad_s_.ci_low * kDegPerHour << ", " << last_drift_rad_s_.ci_high * kDegPerHour
+        << "] deg/h\n";
     if (v.have_state)
       t << "r = " << v.r << " (" << 100.0 * std::fabs(v.r) / std::max(v.r_ref, 1e-300)
         << " % of the start), theta = " << v.theta_rad * 180 / M_PI << " deg\n";
@@ -733,6 +782,9 @@ void IdentifierNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
                   static_cast<unsigned long long>(drops));
   else if (received_ == 0)
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "waiting for data");
+  else if (finished_)
+    stat.summaryf(diagnostic_msgs::DiagnosticStatus::OK,
+                  "finished: final estimate of experiment %u", buffer_experiment_);
   else
     stat.summary(diagnostic_msgs::DiagnosticStatus::OK, "ok");
   stat.add("input_rate_hz", rate);

@@ -296,6 +296,7 @@ void SimulatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
   raw_at_last_diag_ = raw_published_;
   const char* state = running_ == Running::kFreeDecay ? "free decay"
                       : running_ == Running::kSweep   ? "forced sweep"
+                      : experiments_ > 0              ? "finished"
                                                       : "idle";
   // Behind by more than two ticks of simulated time: the requested real-time factor is not met.
   const double tick_s = options_.realtime_factor / options_.publish_rate_hz;

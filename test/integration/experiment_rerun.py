@@ -3,13 +3,21 @@
 experiment 2 (service call, seed 7) are identified separately: the second estimate's window lies
 after the second start, its sample count equals the first's (not the sum), gamma and Q match the
 preset's truth within 5 % (the mixed fit of the issue gave a negative gamma), and get_estimate by
-experiment_id returns experiment 1's estimate unchanged."""
+experiment_id returns experiment 1's estimate unchanged. A rerun is normal bench work (issue #27):
+no WARN or worse from the bench's nodes, no tf frame sent twice at one stamp (TF_REPEATED_DATA in
+rviz), the simulator's and the identifier's diagnostics say "finished", and the rviz panel names
+the gyro and heads with the window-mean drift in deg/h."""
 import threading
 import time
 import unittest
 
 import rospy
 import rostest
+
+from diagnostic_msgs.msg import DiagnosticArray
+from rosgraph_msgs.msg import Log
+from tf2_msgs.msg import TFMessage
+from visualization_msgs.msg import MarkerArray
 
 from cvg_bench.msg import ModelEstimate, SimulationTruth
 from cvg_bench.srv import GetEstimate, StartFreeDecay
@@ -29,11 +37,44 @@ class ExperimentRerun(unittest.TestCase):
         self.truth = None
         rospy.Subscriber("/cvg/estimate", ModelEstimate, self.on_estimate)
         rospy.Subscriber("/cvg/truth", SimulationTruth, self.on_truth)
+        self.warnings = []  # WARN or worse from the bench's nodes
+        self.tf_seen = set()
+        self.tf_repeated = []  # (child frame, stamp) sent more than once
+        self.diag = {}  # node name -> summary message
+        self.panel = ""
+        rospy.Subscriber("/rosout", Log, self.on_log, queue_size=1000)
+        rospy.Subscriber("/tf", TFMessage, self.on_tf, queue_size=1000)
+        rospy.Subscriber("/diagnostics", DiagnosticArray, self.on_diag, queue_size=100)
+        rospy.Subscriber("/cvg/markers", MarkerArray, self.on_markers, queue_size=10)
         self.timeout_s = rospy.get_param("~timeout_s", 25.0)
 
     def on_estimate(self, msg):
         with self.lock:
             self.estimates[msg.experiment_id] = (msg, time.monotonic())
+
+    def on_log(self, msg):
+        if msg.level >= Log.WARN and msg.name.startswith("/cvg/"):
+            with self.lock:
+                self.warnings.append("%s: %s" % (msg.name, msg.msg))
+
+    def on_tf(self, msg):
+        with self.lock:
+            for t in msg.transforms:
+                key = (t.child_frame_id, t.header.stamp.to_nsec())
+                if key in self.tf_seen:
+                    self.tf_repeated.append(key)
+                self.tf_seen.add(key)
+
+    def on_diag(self, msg):
+        with self.lock:
+            for st in msg.status:
+                self.diag[st.name.split(":")[0].strip()] = st.message
+
+    def on_markers(self, msg):
+        with self.lock:
+            for m in msg.markers:
+                if m.ns == "panel" and m.text:
+                    self.panel = m.text
 
     def on_truth(self, msg):
         with self.lock:
@@ -81,6 +122,20 @@ class ExperimentRerun(unittest.TestCase):
         missing = get(experiment_id=99)
         self.assertFalse(missing.success)
         self.assertIn("kept: 1, 2", missing.message)
+        time.sleep(2.5)  # one more diagnostics period (1 s) and panel after the final estimate
+        with self.lock:
+            self.assertEqual(self.warnings, [])
+            self.assertEqual(self.tf_repeated, [])
+            self.assertGreater(len(self.tf_seen), 10)
+            diag = dict(self.diag)
+            panel = self.panel
+        sim = [v for k, v in diag.items() if "simulator" in k]
+        ident = [v for k, v in diag.items() if "identifier" in k]
+        self.assertEqual(sim, ["finished"], diag)
+        self.assertEqual(ident, ["finished: final estimate of experiment 2"], diag)
+        self.assertTrue(panel.startswith("/cvg: experiment 2 finished: final estimate"), panel)
+        self.assertIn("drift (window mean) = ", panel)
+        self.assertIn("deg/h", panel)
 
 
 if __name__ == "__main__":

@@ -2,7 +2,8 @@
 """rostest: dynamic_reconfigure of identifier_node. After the run's estimate (linear, 95 %), a
 lower confidence (90 %) re-identifies the buffered data: same values, intervals narrower by the
 ratio of the Student quantiles (1.645 / 1.960 for ~1500 dof, within 0.5 %); a model change to
-linear+xi adds the xi parameter; an invalid model is refused and the settings stay."""
+linear+xi adds the xi parameter; an invalid model, and values out of range (confidence 1.5,
+forgetting 1.2, window -3 s), are refused and the settings stay (never clamped silently)."""
 import threading
 import time
 import unittest
@@ -50,6 +51,13 @@ class LiveTuning(unittest.TestCase):
         self.assertEqual(cubic.model, "linear+xi")
         applied = client.update_configuration({"model": "bogus"})
         self.assertEqual(applied["model"], "xi")  # refused: the previous setting stays
+        # Out of range: refused with the reason, never clamped silently (issue #27).
+        applied = client.update_configuration({"confidence": 1.5})
+        self.assertAlmostEqual(applied["confidence"], 0.90)
+        applied = client.update_configuration({"rls_forgetting": 1.2})
+        self.assertAlmostEqual(applied["rls_forgetting"], 1.0)
+        applied = client.update_configuration({"window_s": -3.0})
+        self.assertAlmostEqual(applied["window_s"], 0.0)
 
 
 if __name__ == "__main__":

@@ -118,7 +118,7 @@ class LoadCheck(unittest.TestCase):
         def done():
             sim = self.diag.get("sim")
             est = self.estimates.get(experiment_id)
-            return (sim is not None and sim["summary"] == "idle"
+            return (sim is not None and sim["summary"] == "finished"
                     and int(sim["experiments_started"]) == experiment_id and est is not None
                     and float(self.diag["demod"]["input_rate_samples_per_s"]) == 0.0
                     and float(self.diag["ident"]["input_rate_hz"]) == 0.0

@@ -212,7 +212,7 @@ class RecordReplayRoundtrip(unittest.TestCase):
         def live_done():
             sim = self.live.diag.get("resonator_simulator")
             demod = self.live.diag.get("demodulator")
-            return (sim is not None and sim["summary"] == "idle"
+            return (sim is not None and sim["summary"] == "finished"
                     and int(sim["experiments_started"]) == 1 and demod is not None
                     and float(demod["input_rate_samples_per_s"]) == 0.0
                     and self.settled(self.live, 1, int(demod["slow_states_published"])))

@@ -42,6 +42,12 @@ class InstallSpace(unittest.TestCase):
         self.assertIn("usage: cvg_ident", out.stdout)
         self.assertNotIn("loop", out.stderr)
 
+    def test_live_plot_runs_from_the_install_space(self):
+        # Issue #27: scripts/plot_live.py was not installed.
+        out = in_space(os.path.join(INSTALL, "setup.bash"), "rosrun cvg_bench plot_live.py --help")
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertIn("usage: plot_live.py", out.stdout)
+
     def test_presets_come_from_the_install_space(self):
         out = in_space(os.path.join(INSTALL, "setup.bash"),
                        "rosrun cvg_bench cvg_ident simulate --preset no_such_preset --mode forced --out /dev/null")

@@ -31,7 +31,7 @@ class DemodulatorNode {
  private:
   void onRaw(const RawSampleBatch::ConstPtr& msg);
   bool onReset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
-  void resetState(const std::string& why);
+  void resetState(const std::string& why, bool expected);
   /// (Re)builds the core demodulator for reference W and rate; InputError when they do not suit
   /// the filter settings.
   void configure(double omega_rad_s, double sample_rate_hz);

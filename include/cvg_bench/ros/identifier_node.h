@@ -126,6 +126,7 @@ class IdentifierNode {
   /// The buffered window as a core record (t from the first buffered stamp).
   SlowRecord bufferedSlowRecord() const;
   void publishEstimate();
+  void updateWindowDrift();
   void publishFrames();
   /// rviz markers (bench_markers.h): standing wave, axes, text panel.
   void publishMarkers();
@@ -182,6 +183,9 @@ class IdentifierNode {
   double marker_r_ref_ = 0.0;  ///< largest amplitude r of the experiment
   bool have_drift_ = false;
   ParameterEstimate last_drift_rad_s_;
+  bool have_window_drift_ = false;
+  bool finished_ = false;  ///< the estimate is the end-of-data one of the whole buffer
+  ParameterEstimate window_drift_rad_s_;  ///< theta' averaged over the buffer (the headline)
 
   // Free decay buffer (stamps exact; q per stamp).
   std::deque<ros::Time> stamps_;
@@ -193,6 +197,7 @@ class IdentifierNode {
   Eigen::Vector4d latest_q_ = Eigen::Vector4d::Zero();
   ros::Time latest_stamp_;
   ros::Time last_tf_stamp_;
+  ros::Time last_axes_stamp_;  // stiffness/damping axes: strictly increasing stamps
 
   std::unique_ptr<StreamingFreeDecayRls> rls_;
   ros::Time rls_origin_;

@@ -3,8 +3,8 @@
 // from the core's forEachFreeDecayBlock), the first blocks are accumulated in the core's
 // IncrementalQr until they determine every parameter (initialisation by (2.9)), then each block is
 // one BlockRecursiveLeastSquares update. Only the core's estimators are called; this class only
-// feeds them. Intervals: the paper's sigma-hat^2 P with Student-t (2.11) (docs/paper.md item 10: too
-// wide for free decay; the batch `identify` service gives the honest ones).
+// feeds them. Intervals: the paper's sigma-hat^2 P with Student-t (2.11) (docs/paper.md item 10:
+// too wide for free decay; the batch `identify` service gives the honest ones).
 #pragma once
 
 #include <Eigen/Core>

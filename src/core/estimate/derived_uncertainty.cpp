@@ -78,6 +78,19 @@ ParameterEstimate driftRateWithInterval(double r, double k, double theta,
       [&](const ParameterValues& v) { return orbitRatesOfModel(model, v, e).theta_dot; }, p);
 }
 
+ParameterEstimate meanDriftRateWithInterval(const std::vector<OrbitElements>& states,
+                                            const UncertainParameters& p) {
+  if (states.empty()) throw InputError("drift: no state to average over");
+  const ResonatorModel model = freeOscillationModelOf(p.values);
+  return deltaMethod(
+      [&](const ParameterValues& v) {
+        double sum = 0.0;
+        for (const OrbitElements& e : states) sum += orbitRatesOfModel(model, v, e).theta_dot;
+        return sum / static_cast<double>(states.size());
+      },
+      p);
+}
+
 ParameterEstimate qualityFactorFromRate(double omega_rad_s, double rate, double rate_variance,
                                         double confidence, int dof) {
   if (!(rate > 0.0) || !std::isfinite(rate))

@@ -5,8 +5,9 @@
 
 #include <cmath>
 
-#include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/orbit_elements.h"
 
 namespace cvg_bench {
 namespace {
@@ -52,6 +53,24 @@ TEST(DerivedUncertainty, DriftRateIntervalFollowsNu) {
   const ParameterEstimate r = driftRateWithInterval(1.0, 0.05, 0.3, p);
   EXPECT_NEAR(r.value, driftRate(1.0, 0.05, 0.3, p.values), 1e-15);
   EXPECT_NEAR(r.std_error, 0.25 * 0.2, 1e-9);
+}
+
+TEST(DerivedUncertainty, WindowMeanDriftIsTheMeanWithTheMeansInterval) {
+  const UncertainParameters p = example();
+  const std::vector<OrbitElements> states{{1.0, 0.05, 0.3, 0.0}, {0.6, 0.02, -0.5, 0.0}};
+  const ParameterEstimate a = driftRateWithInterval(1.0, 0.05, 0.3, p);
+  const ParameterEstimate b = driftRateWithInterval(0.6, 0.02, -0.5, p);
+  const ParameterEstimate m = meanDriftRateWithInterval(states, p);
+  EXPECT_NEAR(m.value, 0.5 * (a.value + b.value), 1e-15);
+  // Correlated through the shared parameters: the mean's error lies between |a - b| / 2 and the
+  // mean of the two (equality at the ends of perfect correlation); nu alone shifts both by -nu/4.
+  EXPECT_LE(m.std_error, 0.5 * (a.std_error + b.std_error) + 1e-12);
+  EXPECT_GE(m.std_error, 0.5 * std::fabs(a.std_error - b.std_error) - 1e-12);
+  // The drift of one state is its own mean.
+  const ParameterEstimate one = meanDriftRateWithInterval({states[0]}, p);
+  EXPECT_NEAR(one.value, a.value, 1e-15);
+  EXPECT_NEAR(one.std_error, a.std_error, 1e-12);
+  EXPECT_THROW(meanDriftRateWithInterval({}, p), InputError);
 }
 
 }  // namespace

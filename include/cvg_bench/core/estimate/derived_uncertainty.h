@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cvg_bench/core/estimate/estimate.h"
+#include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {
@@ -40,6 +41,12 @@ std::map<std::string, ParameterEstimate> deriveQuantitiesWithIntervals(const Unc
 /// equations of every term the values hold (orbit_rates_chain_rule.h; (5.9) for the paper's).
 ParameterEstimate driftRateWithInterval(double r, double k, double theta,
                                         const UncertainParameters& p);
+
+/// The mean of theta' over states of a record (e.g. a live window) with its CI: the delta method
+/// over the parameters of the mean (the model's prediction averaged, not a measured drift).
+/// InputError when no state is given.
+ParameterEstimate meanDriftRateWithInterval(const std::vector<OrbitElements>& states,
+                                            const UncertainParameters& p);
 
 /// Q = omega / rate from a decay rate with its variance (e.g. the envelope rate c'z, variance
 /// c' cov c): interval from the rate's Student-t interval mapped through omega / rate (asymmetric),
