@@ -63,6 +63,17 @@ std::vector<Step> findSteps(const std::vector<double>& y_db, const RingdownWindo
   return steps;
 }
 
+/// How far the smoothed level falls after its highest point in [a, b) [dB]; 0 when undefined.
+double fallDb(const std::vector<double>& sm, size_t a, size_t b) {
+  double top = -std::numeric_limits<double>::infinity(), fall = 0.0;
+  for (size_t i = a; i < std::min(b, sm.size()); ++i) {
+    if (!std::isfinite(sm[i])) continue;
+    top = std::max(top, sm[i]);
+    fall = std::max(fall, top - sm[i]);
+  }
+  return fall;
+}
+
 }  // namespace
 
 RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vector<double>& y,
@@ -95,15 +106,33 @@ RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vecto
     why << "the record starts " << top - head << " dB under the drive level (floor before the "
         << "drive or its ramp-up): read from " << t[j] << " s";
   }
-  // 2 and 4. Steps after the peak.
+  // 2 and 4. Steps after the peak. Each time the drive comes on again the ring-down so far is
+  // kept as a candidate (2b below).
+  struct Candidate {
+    size_t first, last;
+    std::string why;
+  };
+  std::vector<Candidate> earlier;
+  // The drive level is first reached here; a re-excitation may lie between it and the peak.
+  size_t i_first_top = i_peak;
+  for (size_t i = 0; i < i_peak; ++i)
+    if (std::isfinite(sm[i]) && sm[i] >= top - o.near_top_db) {
+      i_first_top = i;
+      break;
+    }
   for (const Step& s : findSteps(y_db, o)) {
-    if (s.i <= i_peak || s.i <= w.first) continue;
+    if (s.i <= w.first) continue;
     const double jump = s.right - s.left;
+    const bool comes_on_again =
+        s.i > i_first_top && s.right >= top - o.near_top_db && s.left < top - o.near_top_db;
+    if (s.i <= i_peak && !comes_on_again) continue;
     if (s.left >= top - o.near_top_db && jump < 0.0) {
       w.first = s.i;
       why << (why.tellp() > 0 ? "; " : "") << "a step of " << jump << " dB at switch-off ("
           << t[s.i] << " s): the decay is read after it";
-    } else if (s.right >= top - o.near_top_db && jump > 0.0) {
+    } else if (comes_on_again) {
+      const size_t end = s.i > static_cast<size_t>(o.step_half) ? s.i - o.step_half : s.i;
+      if (end > w.first) earlier.push_back({w.first, end, why.str()});
       w.first = s.i;
       why << (why.tellp() > 0 ? "; " : "") << "the drive comes on again at " << t[s.i]
           << " s: the last ring-down is read";
@@ -115,6 +144,30 @@ RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vecto
              "changes range or stops): the record is read up to "
           << t[w.last - 1] << " s";
       break;
+    }
+  }
+  // 2b. The last ring-down is read unless one before a re-excitation falls more than
+  // earlier_burst_margin_db further (a short pulse of the drive, or a burst that ends in a step out
+  // of the band, leaves only a stub of decay after it; the decay before it is the measurement).
+  {
+    // From step_half samples in: the smoothed level at a step still holds the level before it.
+    const double last_fall = fallDb(sm, w.first + o.step_half, w.last);
+    const Candidate* best = nullptr;
+    double best_fall = last_fall + o.earlier_burst_margin_db;
+    for (const Candidate& c : earlier) {
+      const double f = fallDb(sm, c.first + o.step_half, c.last);
+      if (f > best_fall) best = &c, best_fall = f;
+    }
+    if (best) {
+      const size_t last_first = w.first;
+      w.first = best->first;
+      w.last = best->last;
+      why.str(best->why);
+      why.seekp(0, std::ios_base::end);
+      why << (why.tellp() > 0 ? "; " : "") << "the ring-down before the drive came on again "
+          << "falls " << best_fall << " dB, the last one (from " << t[last_first] << " s) "
+          << last_fall << " dB: the record is read from " << t[w.first] << " s up to "
+          << t[w.last - 1] << " s";
     }
   }
   // 6. A noiseless tail: from some sample to the window's end the local roughness (median

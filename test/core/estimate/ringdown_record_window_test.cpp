@@ -80,5 +80,37 @@ TEST(RingdownWindow, ASmoothGainStepOfTheGeneratorIsNoStep) {
   EXPECT_EQ(w.last, 600u);
 }
 
+TEST(RingdownWindow, ADrivePulseAfterTheDecayLeavesTheDecayBeforeIt) {
+  // D154/D167 of the development set: plateau 0 dB to 50 s, decay 0.3 dB/s to a -60 dB floor,
+  // the drive on again 400-430 s (1 dB higher: the peak lies in the pulse), then a step out of
+  // the band to -70 dB falling 0.02 dB/s: a 5 dB stub of "decay" after the pulse.
+  const Rec r = make(700, [](double t) {
+    if (t < 50) return 0.0;
+    if (t < 400) return std::max(-0.3 * (t - 50), -60.0);
+    if (t < 430) return 1.0;
+    return -70.0 - 0.02 * (t - 430);
+  });
+  const RingdownWindow w = findRingdownWindow(r.t, r.y);
+  EXPECT_EQ(w.first, 0u);
+  EXPECT_GE(w.last, 394u);  // up to the pulse, less the medians' half-width
+  EXPECT_LE(w.last, 400u);
+  EXPECT_NE(w.why.find("before the drive came on again"), std::string::npos) << w.why;
+}
+
+TEST(RingdownWindow, ARerunWithAFullDecayIsReadLast) {
+  // Two full ring-downs: the last is read (the earlier one falls no further).
+  const Rec r = make(800, [](double t) {
+    if (t < 50) return 0.0;
+    if (t < 350) return std::max(-0.3 * (t - 50), -60.0);
+    if (t < 400) return 0.0;
+    return std::max(-0.3 * (t - 400), -60.0);
+  });
+  const RingdownWindow w = findRingdownWindow(r.t, r.y);
+  EXPECT_GE(w.first, 348u);
+  EXPECT_LE(w.first, 352u);
+  EXPECT_EQ(w.last, 800u);
+  EXPECT_NE(w.why.find("the last ring-down is read"), std::string::npos) << w.why;
+}
+
 }  // namespace
 }  // namespace cvg_bench

@@ -11,6 +11,9 @@
 //  2. The drive level is the peak of the smoothed envelope. A step down that starts within
 //     near_top_db of it after the peak is a switch-off step: the window starts after it. A step up
 //     back to within near_top_db is the drive coming on again: the window restarts there.
+//  2b. When the drive came on again, a ring-down before it that falls more than
+//     earlier_burst_margin_db further than the last one is read instead (a drive pulse, or a
+//     burst that steps out of the band, leaves only a stub of decay).
 //  3. A record that starts more than start_below_db under the drive level (it begins at the floor
 //     or on the ramp-up) starts at its last rise through near_top_db / 2 below the peak.
 //  4. Any other step after the decay has begun (over near_top_db down) ends the window before it
@@ -40,6 +43,9 @@ struct RingdownWindowOptions {
   int step_half = 3;
   /// Within this of the peak level [dB]: still the drive level (switch-off, drive on again).
   double near_top_db = 6.0;
+  /// A ring-down before a re-excitation is read instead of the last when it falls this much
+  /// further [dB] (the development set's drive pulses leave 12-15 dB stubs after 55-60 dB decays).
+  double earlier_burst_margin_db = 20.0;
   /// A record whose first 2 % lie this far under the peak [dB] starts before the drive.
   double start_below_db = 10.0;
   /// The drive level is held while the smoothed envelope is within this of its peak [dB].
