@@ -9,7 +9,7 @@ instrument behaviour behind it; Q must come within 5 % of the authors' published
 - D126: a step at switch-off;
 - D146: a switch-off transient that undershoots the decay's line and comes back;
 - D309, D145 (refused before 28 Nov): a decay followed by the drive on again, or by a clipped
-  stretch at the drive level; D061: an amplitude law's Q is the span's mean decay; D204, D103: a
+  stretch at the drive level (the ring-down before it is read); D061: an amplitude law's Q is the span's mean decay; D204, D103: a
   tail that bends into a floor no rule confirmed.
 Every Q interval must be positive and of non-zero width, and the span part of the uncertainty
 must be reported. Skipped when the data or the tool is absent."""
@@ -77,12 +77,14 @@ class RealRingdowns(unittest.TestCase):
         self.check("D146", "dips")
 
     def test_decay_then_drive_on_again(self):
-        # Refused before 28 Nov: the highest drive-on stretch is the last, nothing decays after it.
-        self.check("D309", "holds no decay")
+        # Refused before 28 Nov: the highest drive-on stretch is the last, nothing decays after it;
+        # since 28 Nov the ring-down before the drive came on again is read (it falls 20 dB more).
+        self.check("D309", "before the drive came on again")
 
     def test_decay_then_clipped_stretch(self):
-        # A clipped stretch at the drive level after the decay was read as a re-excitation.
-        self.check("D145", "holds no decay")
+        # A clipped stretch at the drive level after the decay was read as a re-excitation; the
+        # decay before it is read (28 Nov: it falls 20 dB more than what follows the stretch).
+        self.check("D145", "before the drive came on again")
 
     def test_tail_bending_into_an_unconfirmed_floor(self):
         # No floor confirmed or suspected; the last quarter slows and scatters more: the span
