@@ -16,6 +16,7 @@
 #include "cvg_bench/report/explain_json.h"
 #include "cvg_ident_commands.h"
 #include "explain_report_files.h"
+#include "term_help.h"
 
 namespace cvg_bench {
 namespace tools {
@@ -30,10 +31,8 @@ const char* kHelp =
     "         [--candidates a,b,...] [--holdout-fraction F] [--columns t=COL,f=COL,g=COL]\n"
     "         [--no-figures] [--threads N]\n"
     "Fits the linear model, shows what it gets wrong (residual signature against amplitude^2,\n"
-    "amplitude^4, time or detuning, pattern angle), tries the candidate extensions (free decay: "
-    "xi,\n"
-    "kappa, gamma_nl, cm_rate, xi_diff, xi_k; forced: xi, kappa, mu, gamma_nl, xi_diff) by\n"
-    "forward "
+    "amplitude^4, time or detuning, pattern angle), tries the candidate extensions (free decay:\n"
+    "{CANDIDATES_FREE_DECAY}; forced: {CANDIDATES_FORCED}) by forward\n"
     "selection (Wald test with the honest covariance, Bonferroni over the candidates of a step at\n"
     "level --alpha (0.01), hold-out prediction must improve), tests the final model's lack of fit\n"
     "(runs test) and prints the verdict. --json FILE ('-' = stdout) writes the explain JSON of\n"
@@ -88,7 +87,7 @@ int runExplain(const std::vector<std::string>& argv) {
                       "alpha", "candidates", "holdout-fraction", "columns", "topic", "threads"},
                      {"no-figures"});
   if (args.help()) {
-    std::cout << kHelp;
+    std::cout << withTermLists(kHelp);
     return 0;
   }
   if (args.positionals().size() != 1) throw InputError("explain needs exactly one INPUT file");

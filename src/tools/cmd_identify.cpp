@@ -16,6 +16,7 @@
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
+#include "term_help.h"
 
 namespace cvg_bench {
 namespace tools {
@@ -36,10 +37,8 @@ const char* kHelp =
     "messages\n"
     "  --topic  bag topic to read (default: the one topic of a project message type)\n"
     "  --columns  raw input with other column names or orders (as explain and demod)\n"
-    "  --model  linear, or +-joined extensions: xi, kappa, gamma_nl, cm_rate (free decay), "
-    "xi_diff,\n"
-    "           xi_k (second cubic invariant: precession proportional to r k),\n"
-    "           mu (forced, needs --method ceres: mu multiplies u~ bilinearly).\n"
+    "  --model  linear, or +-joined extensions (mu multiplies u~ bilinearly: LS cannot fit it):\n"
+    "{MODEL_TERMS}\n"
     "  --method ls (batch QR, default), rls (block recursive LS (2.12)), ceres (output-error fit\n"
     "           started from LS; removes the errors-in-variables bias of noisy forced sweeps).\n"
     "  --confidence P0 of the intervals (default 0.95); --angular-gain K (default 0.4);\n"
@@ -113,7 +112,7 @@ int runIdentify(const std::vector<std::string>& argv) {
                       "mu", "topic", "columns"},
                      {});
   if (args.help()) {
-    std::cout << kHelp;
+    std::cout << withTermLists(kHelp);
     return 0;
   }
   if (args.positionals().size() != 1) throw InputError("identify needs exactly one INPUT file");

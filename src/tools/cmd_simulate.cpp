@@ -10,6 +10,7 @@
 #include "cvg_bench/core/simulate/experiment_runner.h"
 #include "cvg_bench/core/simulate/whole_angle_simulator.h"
 #include "cvg_ident_commands.h"
+#include "term_help.h"
 
 namespace cvg_bench {
 namespace tools {
@@ -38,10 +39,10 @@ const char* kHelp =
     "  --raw             raw f, g of the full equations (2.3)/(3.1) instead (t,f,g); forced: one\n"
     "                    segment per settled step with columns omega0 and drive_phase_rad\n"
     "  --seed N          seed of the Gaussian measurement noise (default 1)\n"
-    "  --effect N=V      set a true parameter (repeatable): gamma nu b_c b_s c_m n h_c h_s xi\n"
-    "                    kappa gamma_nl cm_rate xi_diff xi_k (model terms), u1..u4 (drive u~), mu\n"
-    "                    (control nonlinearity), eta (2 omega0 parametric terms of (2.1), raw\n"
-    "                    forced only; 0 = off)\n"
+    "  --effect N=V      set a true parameter (repeatable); the model terms' parameters, u1..u4\n"
+    "                    the drive u~, mu the control nonlinearity, eta the 2 omega0 parametric\n"
+    "                    terms of (2.1) (raw forced only, 0 = off):\n"
+    "{EFFECT_NAMES}\n"
     "  --noise STD       noise std overriding the preset's (q, or f, g with --raw); 0 = none\n"
     "  --duration S      record length [s] overriding the preset's (forced --raw: per step)\n"
     "  --start R,K,THETA free decay only: start from the orbit elements (5.2) amplitude R > 0,\n"
@@ -59,7 +60,7 @@ int runSimulate(const std::vector<std::string>& argv) {
                       "amplitude", "quadrature", "walk"},
                      {"raw"}, {"effect"});
   if (args.help()) {
-    std::cout << kHelp;
+    std::cout << withTermLists(kHelp);
     return 0;
   }
   if (!args.positionals().empty())

@@ -8,6 +8,7 @@
 #include "cvg_bench/core/diagnose/low_frequency_misfit.h"
 #include "cvg_bench/core/diagnose/sweep_noise_model.h"
 #include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/model_term.h"
 
 namespace cvg_bench {
 
@@ -125,8 +126,7 @@ std::string amplitudeTimeCaveat(const Explanation& x, ExperimentMode mode) {
   if (mode != ExperimentMode::kFreeDecay) return "";
   std::vector<std::string> laws;
   for (const auto& t : x.selection.selected)
-    if (t == "xi" || t == "kappa" || t == "gamma_nl" || t == "xi_diff" || t == "xi_k")
-      laws.push_back(t);
+    if (isAmplitudeLawTerm(t)) laws.push_back(t);
   if (laws.empty()) return "";
   // The time constant from the record's Q (the envelope's decay, which one record identifies),
   // not from gamma, which a single standing wave does not separate from b_c, b_s, n

@@ -6,12 +6,14 @@
 #include <cmath>
 #include <cstdio>
 
+#include "cvg_bench/core/model/model_term.h"
+
 namespace cvg_bench {
 namespace {
 
+// An amplitude law's parameter (declared by its ModelTerm): constant amplitude cannot separate it.
 bool isNonlinear(const std::string& name) {
-  return name == "xi" || name == "kappa" || name == "gamma_nl" || name == "xi_diff" ||
-         name == "xi_k";
+  return isAmplitudeLawParameter(name);
 }
 
 std::string coefficientText(double c, bool first) {

@@ -23,6 +23,17 @@ class AngularMomentumCubicTerm : public ModelTerm {
     return "second isotropic cubic invariant: precession proportional to the angular momentum "
            "(r k), no amplitude-frequency shift";
   }
+  std::vector<CandidateExtension> candidates() const override {
+    // Offered for free decay, where the orbit's quadrature k evolves; in forced sweeps it is a
+    // term of `identify --model` but not yet validated as a candidate.
+    return {{"xi_k", "xi_k",
+             "second cubic invariant (angular-momentum coupling, e.g. Airy precession)",
+             "1/(s amp^2)",
+             "pattern-angle drift proportional to r k (the ellipse's area) that xi's frequency law "
+             "cannot carry",
+             false, true, false, 6}};
+  }
+  bool isAmplitudeLaw() const override { return true; }
   void averagedColumns(const Eigen::Vector4d& q, const SlowContext&,
                        Eigen::Ref<Eigen::MatrixXd> d) const override {
     const double half_l = 0.5 * (q[0] * q[3] - q[1] * q[2]);

@@ -16,6 +16,12 @@ class AxisCubicMismatchTerm : public ModelTerm {
   std::string description() const override {
     return "unequal cubic stiffness on the two axes (nonlinearity anisotropy)";
   }
+  std::vector<CandidateExtension> candidates() const override {
+    return {{"xi_diff", "xi_diff", "unequal cubic stiffness of the two axes", "1/(s amp^2)",
+             "amplitude-dependent residual that depends on the pattern angle theta", false, true,
+             true, 5}};
+  }
+  bool isAmplitudeLaw() const override { return true; }
   void averagedColumns(const Eigen::Vector4d& q, const SlowContext&,
                        Eigen::Ref<Eigen::MatrixXd> d) const override {
     const SlowComplex z(q);

@@ -20,6 +20,12 @@ class ControlTerm : public ModelTerm {
   std::string description() const override {
     return "drive voltages u1..u4 at omega0 with control nonlinearity mu (3.1)";
   }
+  std::vector<CandidateExtension> candidates() const override {
+    // mu of (3.1)-(3.2), the known nonlinearity of the controls, identified as an extension.
+    return {{"mu", "mu", "control (actuator) nonlinearity", "1/amp^2",
+             "residual concentrated near resonance where the drive acts on large amplitudes", true,
+             false, true, 2}};
+  }
   bool appliesTo(ExperimentMode mode) const override { return mode == ExperimentMode::kForced; }
   void averagedColumns(const Eigen::Vector4d& q, const SlowContext& c,
                        Eigen::Ref<Eigen::MatrixXd> d) const override {

@@ -18,6 +18,11 @@ class CubicStiffnessTerm : public ModelTerm {
   std::string description() const override {
     return "cubic stiffness: the natural frequency depends on amplitude squared (Duffing)";
   }
+  std::vector<CandidateExtension> candidates() const override {
+    return {{"xi", "xi", "cubic stiffness", "1/(s amp^2)",
+             "phase-rate (tangential) residual growing with amplitude^2", false, true, true, 0}};
+  }
+  bool isAmplitudeLaw() const override { return true; }
   void averagedColumns(const Eigen::Vector4d& q, const SlowContext&,
                        Eigen::Ref<Eigen::MatrixXd> d) const override {
     const SlowComplex z(q);

@@ -13,6 +13,10 @@ class FrequencyDriftTerm : public ModelTerm {
   std::string description() const override {
     return "natural frequency drifting linearly in time during the record (temperature drift)";
   }
+  std::vector<CandidateExtension> candidates() const override {
+    return {{"cm_rate", "cm_rate", "natural-frequency drift during the record", "1/s^2",
+             "phase-rate (tangential) residual growing linearly with time", false, true, false, 4}};
+  }
   bool appliesTo(ExperimentMode mode) const override { return mode == ExperimentMode::kFreeDecay; }
   void averagedColumns(const Eigen::Vector4d& q, const SlowContext& c,
                        Eigen::Ref<Eigen::MatrixXd> d) const override {

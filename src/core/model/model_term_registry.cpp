@@ -34,4 +34,20 @@ std::vector<std::string> knownModelTermNames() {
   return names;
 }
 
+bool isAmplitudeLawParameter(const std::string& parameter) {
+  for (const auto& entry : registry()) {
+    const ModelTermPtr t = entry.second();
+    if (!t->isAmplitudeLaw()) continue;
+    for (const auto& p : t->parameterNames())
+      if (p == parameter) return true;
+  }
+  return false;
+}
+
+bool isAmplitudeLawTerm(const std::string& name) {
+  for (const auto& entry : registry())
+    if (entry.first == name) return entry.second()->isAmplitudeLaw();
+  return false;
+}
+
 }  // namespace cvg_bench

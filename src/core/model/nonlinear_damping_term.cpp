@@ -20,6 +20,11 @@ class NonlinearDampingTerm : public ModelTerm {
            "(air/thermoelastic "
            "or anchor loss nonlinearity)";
   }
+  std::vector<CandidateExtension> candidates() const override {
+    return {{"gamma_nl", "gamma_nl", "amplitude-dependent damping", "1/(s amp^2)",
+             "amplitude-rate (radial) residual growing with amplitude^2", false, true, true, 3}};
+  }
+  bool isAmplitudeLaw() const override { return true; }
   void averagedColumns(const Eigen::Vector4d& q, const SlowContext&,
                        Eigen::Ref<Eigen::MatrixXd> d) const override {
     const SlowComplex z(q);

@@ -17,6 +17,11 @@ class QuinticStiffnessTerm : public ModelTerm {
   std::string description() const override {
     return "quintic stiffness: frequency shift growing with the fourth power of amplitude";
   }
+  std::vector<CandidateExtension> candidates() const override {
+    return {{"kappa", "kappa", "quintic stiffness", "1/(s amp^4)",
+             "phase-rate (tangential) residual growing with amplitude^4", false, true, true, 1}};
+  }
+  bool isAmplitudeLaw() const override { return true; }
   void averagedColumns(const Eigen::Vector4d& q, const SlowContext&,
                        Eigen::Ref<Eigen::MatrixXd> d) const override {
     const SlowComplex z(q);

@@ -54,6 +54,27 @@ struct FastContext {
   double drive_cos = std::numeric_limits<double>::quiet_NaN();
 };
 
+/// An extension of the linear base that `explain` tries as a nested model (the linear model plus
+/// one term, or mu of the controls term), with the physical cause in words and the residual
+/// signature it removes. Declared by the term that owns it (ModelTerm::candidates); the list
+/// explain uses is src/core/diagnose/candidate_extensions.cpp walking the registry.
+struct CandidateExtension {
+  std::string name;       ///< extension name in a model specification: "xi", "mu", ...
+  std::string parameter;  ///< the parameter it adds (same as name for all current candidates)
+  std::string cause;      ///< the physical cause, a short noun phrase ("cubic stiffness")
+  std::string unit;       ///< unit of the parameter in regression units, e.g. "1/(s amp^2)"
+  /// What its absence leaves in the residuals (the signature it removes), in words.
+  std::string signature;
+  /// Estimated by output error (Ceres): mu multiplies u~ bilinearly (3.2), LS cannot fit it.
+  bool needs_output_error = false;
+  /// Offered in free decay / forced data (validated there as a candidate).
+  bool free_decay = true;
+  bool forced = true;
+  /// Position in explain's candidate list (the order of forward selection's ties and of the
+  /// JSON's lists; kept as it was before the terms owned their candidacy).
+  int rank = 0;
+};
+
 class ModelTerm {
  public:
   virtual ~ModelTerm() = default;
@@ -65,6 +86,12 @@ class ModelTerm {
   virtual std::string description() const = 0;
   /// Whether the term exists in the given experiment mode (e.g. controls only when forced).
   virtual bool appliesTo(ExperimentMode mode) const { return true; }
+  /// The extensions of the linear base this term offers to `explain` (none by default).
+  virtual std::vector<CandidateExtension> candidates() const { return {}; }
+  /// An amplitude law: its force grows faster than linearly with the amplitude, so data at one
+  /// amplitude cannot tell it from the linear terms (identifiability.cpp), and in one free decay
+  /// it is tied to time through the decay (explain's caveat, explanation.cpp).
+  virtual bool isAmplitudeLaw() const { return false; }
   /// 4 x k columns of the averaged regressor D(q) (2.6)/(3.3).
   virtual void averagedColumns(const Eigen::Vector4d& q, const SlowContext& ctx,
                                Eigen::Ref<Eigen::MatrixXd> cols) const = 0;
@@ -91,5 +118,10 @@ using ModelTermPtr = std::shared_ptr<const ModelTerm>;
 ModelTermPtr makeModelTerm(const std::string& name);
 /// Names of all terms makeModelTerm knows, base terms first.
 std::vector<std::string> knownModelTermNames();
+/// Whether the parameter belongs to a registered amplitude law (ModelTerm::isAmplitudeLaw).
+bool isAmplitudeLawParameter(const std::string& parameter);
+/// Whether the named extension (a term name) is a registered amplitude law; false for unknown
+/// names and for extensions that are no term (mu).
+bool isAmplitudeLawTerm(const std::string& name);
 
 }  // namespace cvg_bench
