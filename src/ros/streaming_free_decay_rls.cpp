@@ -5,9 +5,9 @@
 #include <cmath>
 
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/estimate/free_decay_regression.h"
 #include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 

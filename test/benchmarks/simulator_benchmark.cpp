@@ -1,13 +1,14 @@
 // Simulator speed as a multiple of real time (counter x_real_time):
-//  - full equations (FullEquationSimulator) of the mems_ring preset's forced truth model at 20 RK4 steps
+//  - full equations (FullEquationSimulator) of the mems_ring preset's forced truth model at 20 RK4
+//  steps
 //    per period (target >= 20x real time);
-//  - the averaged model (AveragedModelSimulator) over an hour-long ring-down of the hrg_hemispherical
-//  preset.
+//  - the averaged model (AveragedModelSimulator) over an hour-long ring-down of the
+//  hrg_hemispherical preset.
 #include <benchmark/benchmark.h>
 
-#include "cvg_bench/core/simulate/full_equation_simulator.h"
 #include "cvg_bench/core/model/resonator_preset.h"
 #include "cvg_bench/core/simulate/averaged_model_simulator.h"
+#include "cvg_bench/core/simulate/full_equation_simulator.h"
 
 namespace cvg_bench {
 namespace {

@@ -1,6 +1,6 @@
 // libFuzzer target: the files `cvg_ident batch` reads back (docs/fleet.md): a manifest CSV
-// (expandBatchInputs), a record's status file (readBatchStatus) and a status/record JSON turned into
-// a fleet row (fleetRow), as a hand-edited, truncated or foreign file may hold anything. Only
+// (expandBatchInputs), a record's status file (readBatchStatus) and a status/record JSON turned
+// into a fleet row (fleetRow), as a hand-edited, truncated or foreign file may hold anything. Only
 // InputError may leave them.
 #include <cstdint>
 #include <nlohmann/json.hpp>

@@ -1,12 +1,13 @@
 // The identifier node's recursive mode: block RLS fed one slow state at a time reaches the batch
-// least-squares estimate at forgetting factor 1 (docs/paper.md item 9), on a seeded simulated decay.
+// least-squares estimate at forgetting factor 1 (docs/paper.md item 9), on a seeded simulated
+// decay.
 #include "cvg_bench/ros/streaming_free_decay_rls.h"
 
 #include <gtest/gtest.h>
 
+#include "cvg_bench/core/estimate/identification.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/experiment_runner.h"
-#include "cvg_bench/core/estimate/identification.h"
 
 namespace cvg_bench {
 namespace {

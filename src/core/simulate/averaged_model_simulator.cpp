@@ -17,8 +17,10 @@ std::vector<std::string> AveragedModelSimulatorOptions::validate() const {
   return p;
 }
 
-AveragedModelSimulator::AveragedModelSimulator(const ResonatorModel& model, const Eigen::VectorXd& z, double mu,
-                             double detuning_rate, const AveragedModelSimulatorOptions& options)
+AveragedModelSimulator::AveragedModelSimulator(const ResonatorModel& model,
+                                               const Eigen::VectorXd& z, double mu,
+                                               double detuning_rate,
+                                               const AveragedModelSimulatorOptions& options)
     : model_(model), z_(z), mu_(mu), rate_(detuning_rate), options_(options) {
   requireFinite(mu, "mu");
   requireFinite(detuning_rate, "detuning rate");

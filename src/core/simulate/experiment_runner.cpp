@@ -5,10 +5,10 @@
 #include <cstdio>
 
 #include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/stationary_solver.h"
+#include "cvg_bench/core/simulate/averaged_model_simulator.h"
 #include "cvg_bench/core/simulate/full_equation_simulator.h"
 #include "cvg_bench/core/simulate/measurement_noise.h"
-#include "cvg_bench/core/simulate/averaged_model_simulator.h"
-#include "cvg_bench/core/model/stationary_solver.h"
 
 namespace cvg_bench {
 namespace {
@@ -183,8 +183,8 @@ RawRecord ExperimentRunner::freeDecayRaw(double duration_s, const Eigen::Vector4
                              ExperimentMode::kFreeDecay);
   FullEquationSimulatorOptions fo;
   fo.steps_per_period = preset_.steps_per_period;
-  FullEquationSimulator sim(model, preset_.truthParameters(model), preset_.omega_rad_s, preset_.omega_rad_s,
-                    0.0, {}, fo);
+  FullEquationSimulator sim(model, preset_.truthParameters(model), preset_.omega_rad_s,
+                            preset_.omega_rad_s, 0.0, {}, fo);
   sim.reset(q0, 0.0);
   RawRecord rec;
   rec.omega_rad_s = preset_.omega_rad_s;
@@ -268,7 +268,8 @@ RawRecord ExperimentRunner::forcedSweepRaw(const SweepResult& sweep, double segm
   auto& phase_col = rec.extra["drive_phase_rad"];
   double t_offset = 0.0;
   for (const SweepStep& step : sweep.steps) {
-    FullEquationSimulator sim(model, z, preset_.omega_rad_s, step.omega0_rad_s, preset_.mu, pumping, fo);
+    FullEquationSimulator sim(model, z, preset_.omega_rad_s, step.omega0_rad_s, preset_.mu, pumping,
+                              fo);
     sim.reset(step.q, 0.0);
     sim.advanceTo(preset_.sweep_raw_settle_s);
     RawRecord seg;

@@ -25,8 +25,9 @@ std::vector<std::string> FullEquationSimulatorOptions::validate() const {
 }
 
 FullEquationSimulator::FullEquationSimulator(const ResonatorModel& model, const Eigen::VectorXd& z,
-                             double omega_rad_s, double reference_rad_s, double mu,
-                             const ParametricPumping& pumping, const FullEquationSimulatorOptions& options)
+                                             double omega_rad_s, double reference_rad_s, double mu,
+                                             const ParametricPumping& pumping,
+                                             const FullEquationSimulatorOptions& options)
     : model_(model), z_(z), omega_(omega_rad_s), w_(reference_rad_s), mu_(mu), pumping_(pumping) {
   requirePositive(omega_rad_s, "omega");
   requirePositive(reference_rad_s, "reference frequency W");
@@ -100,7 +101,8 @@ FastState FullEquationSimulator::fastState() const {
                    w_ * (x_[3] * c - x_[2] * s)};
 }
 
-Eigen::Vector4d FullEquationSimulator::rhs(double t, const Eigen::Vector4d& x, double c, double s) const {
+Eigen::Vector4d FullEquationSimulator::rhs(double t, const Eigen::Vector4d& x, double c,
+                                           double s) const {
   const FastState st{x[0] * c + x[1] * s, w_ * (x[1] * c - x[0] * s), x[2] * c + x[3] * s,
                      w_ * (x[3] * c - x[2] * s)};
   // The reference runs at W = omega0, the drive frequency: (c, s) are the drive phase's cos, sin.

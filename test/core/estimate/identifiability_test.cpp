@@ -1,5 +1,5 @@
-// Identifiability (docs/paper.md item 11): a pure standing wave determines only 4 combinations of the 8
-// linear parameters; two runs at pattern angles 0 and pi/8 determine all.
+// Identifiability (docs/paper.md item 11): a pure standing wave determines only 4 combinations of
+// the 8 linear parameters; two runs at pattern angles 0 and pi/8 determine all.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,13 +1,14 @@
 // The streaming QR solver against a dense reference, and its rank decisions.
+#include "cvg_bench/core/estimate/least_squares_solver.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/LU>
 #include <Eigen/QR>
 #include <random>
 
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/estimate/least_squares_solver.h"
 #include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

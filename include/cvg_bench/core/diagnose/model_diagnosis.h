@@ -1,7 +1,7 @@
 // Statistics of nested model comparison and model adequacy used by `explain`.
 //
-// Nested test. The equation errors of (2.8) are correlated (docs/paper.md item 10) and those of (3.4)
-// are heteroscedastic and correlated within a sweep point, so the classical nested F-test on
+// Nested test. The equation errors of (2.8) are correlated (docs/paper.md item 10) and those of
+// (3.4) are heteroscedastic and correlated within a sweep point, so the classical nested F-test on
 // residual sums of squares has the wrong null distribution. The test used is the Wald test on the
 // added parameters with the identification's HONEST covariance (Estimate::covariance: sandwich
 // with the lag-2 block structure in free decay, per-point clusters in forced mode):

@@ -8,8 +8,8 @@
 // amplitude^4, time (free decay) or detuning lambda (forced), and the pattern angle theta (5.2);
 // e.g. a missing cubic stiffness leaves a tangential residual growing with amplitude^2, a missing
 // frequency drift one growing with time, a missing nonlinear damping a radial one with amplitude^2.
-// Free-decay blocks share samples (docs/paper.md item 10): correlations and their p-values use every
-// `stride`-th block (stride >= 3 makes the noise of the blocks used independent).
+// Free-decay blocks share samples (docs/paper.md item 10): correlations and their p-values use
+// every `stride`-th block (stride >= 3 makes the noise of the blocks used independent).
 #pragma once
 
 #include <Eigen/Core>

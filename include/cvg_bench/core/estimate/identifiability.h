@@ -1,7 +1,7 @@
 // Identifiability of a regression: which parameters, or combinations, the data cannot separate,
 // and why in words, from the null space of the column-equilibrated regression matrix.
-// Example (docs/paper.md item 11): a pure standing wave (q2 = p2 = 0 throughout) gives rank 4 of 8 in
-// the linear model; only gamma+b_c, nu+b_s, c_m+h_c, n-h_s are determined.
+// Example (docs/paper.md item 11): a pure standing wave (q2 = p2 = 0 throughout) gives rank 4 of 8
+// in the linear model; only gamma+b_c, nu+b_s, c_m+h_c, n-h_s are determined.
 #pragma once
 
 #include <Eigen/Core>

@@ -69,8 +69,8 @@ struct IdentificationOptions {
 /// time since the record's first sample). InputError for bad input (fewer than 3 samples + enough
 /// equations for the model, NaN/Inf, non-increasing times, constant data, bad options).
 Estimate identifyFreeDecay(const SlowRecord& record, const IdentificationOptions& options);
-/// Several records stacked into one regression (e.g. runs at different pattern angles, docs/paper.md
-/// item 11); each record keeps its own time origin and lag structure.
+/// Several records stacked into one regression (e.g. runs at different pattern angles,
+/// docs/paper.md item 11); each record keeps its own time origin and lag structure.
 Estimate identifyFreeDecay(const std::vector<SlowRecord>& records,
                            const IdentificationOptions& options);
 

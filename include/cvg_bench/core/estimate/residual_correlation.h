@@ -15,7 +15,10 @@ class ResidualLagAccumulator {
   /// The next time step's residual 4-vector.
   void add(const Eigen::Vector4d& r);
   /// The following residuals start a new record.
-  void startRecord() { in_record_ = 0; head_ = 0; }
+  void startRecord() {
+    in_record_ = 0;
+    head_ = 0;
+  }
   std::vector<double> correlations() const;
   long steps() const { return steps_; }
 

@@ -33,7 +33,8 @@ class AveragedModelSimulator {
   /// detuning_rate: (omega0^2 - omega^2) / omega0 [rad/s] (0 in free decay). InputError on bad
   /// input.
   AveragedModelSimulator(const ResonatorModel& model, const Eigen::VectorXd& z, double mu = 0.0,
-                double detuning_rate = 0.0, const AveragedModelSimulatorOptions& options = {});
+                         double detuning_rate = 0.0,
+                         const AveragedModelSimulatorOptions& options = {});
 
   void reset(const Eigen::Vector4d& q, double t_s = 0.0);
   const Eigen::Vector4d& state() const { return q_; }

@@ -2,7 +2,8 @@
 //  - FREE DECAY (section 2): the resonator is driven into the stationary forced oscillation at the
 //    preset's drive u~ and detuning (stationary averaged equations (3.3), settled then solved by
 //    Newton), the controls are switched off at t = 0 and the decay is recorded: slow variables by
-//    the averaged model (AveragedModelSimulator), or raw f, g by the full equations (FullEquationSimulator).
+//    the averaged model (AveragedModelSimulator), or raw f, g by the full equations
+//    (FullEquationSimulator).
 //  - FORCED SWEEP (section 3): the detuning lambda = omega0 - omega is stepped over the preset's
 //    range; each step starts from the previous step's state and is settled by integrating the
 //    averaged model (3.3) until stationary, then polished by Newton. A nonlinear resonator is
@@ -20,9 +21,9 @@
 #include <string>
 #include <vector>
 
-#include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/io/record_io.h"
 #include "cvg_bench/core/io/records.h"
+#include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/resonator_preset.h"
 
 namespace cvg_bench {

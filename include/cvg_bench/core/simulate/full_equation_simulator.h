@@ -49,8 +49,9 @@ class FullEquationSimulator {
   /// natural frequency omega; reference_rad_s: W (= omega for free decay, = omega0 forced; the
   /// drive phase of the controls is W t); mu: known control nonlinearity. InputError on bad input.
   FullEquationSimulator(const ResonatorModel& model, const Eigen::VectorXd& z, double omega_rad_s,
-                double reference_rad_s, double mu = 0.0, const ParametricPumping& pumping = {},
-                const FullEquationSimulatorOptions& options = {});
+                        double reference_rad_s, double mu = 0.0,
+                        const ParametricPumping& pumping = {},
+                        const FullEquationSimulatorOptions& options = {});
 
   /// Sets the osculating state x = (q1, p1, q2, p2) at time t_s (t enters the phase W t and the
   /// slowly varying terms, e.g. cm_rate).
