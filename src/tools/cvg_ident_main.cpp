@@ -11,12 +11,13 @@ namespace {
 
 const char* kUsage =
     "usage: cvg_ident <subcommand> [options]   (every subcommand has --help)\n"
-    "  simulate  --preset NAME|--config FILE --mode free_decay|forced [--raw] [--seed N]\n"
-    "            [--effect NAME=VALUE ...] --out FILE\n"
+    "  simulate  --preset NAME|--config FILE --mode free_decay|forced|whole_angle [--raw]\n"
+    "            [--seed N] [--effect NAME=VALUE ...] --out FILE\n"
     "  demod     INPUT [--omega W] [--rate HZ] [--columns t=COL,f=COL,g=COL] --out FILE\n"
     "  identify  INPUT --mode free_decay|forced --model TERMS [--method ls|rls|ceres]\n"
     "            [--confidence P] [--omega W] [--angular-gain K] [--json FILE]\n"
     "  drift     --params FILE.json [--r R --k K --theta TH | --theta-grid N] [--json FILE]\n"
+    "  drift     --params FILE.json --measured RECORD [--json FILE]   measured vs predicted (5.9)\n"
     "  explain   INPUT --mode free_decay|forced [--json FILE] [--report DIR]\n"
     "  identify|explain INPUT --mode ringdown [--frequency HZ] ...   single-channel ring-downs\n"
     "  simulate  --mode ringdown --out FILE ...                      (see --mode ringdown --help)\n"
