@@ -54,7 +54,9 @@ TEST(NestedModelFitters, CheapFitsFromTheWidestFactorEqualTheStackedLs) {
     // Residuals for the linear model and the widest fit; not for strict subsets of the widest.
     const bool expect_residuals = ext.empty() || ext.size() == 4;
     EXPECT_EQ(f.residuals.size() > 0, expect_residuals) << f.model;
-    if (expect_residuals) EXPECT_NEAR(f.residuals.squaredNorm(), d.rss, 1e-9 * d.rss);
+    if (expect_residuals) {
+      EXPECT_NEAR(f.residuals.squaredNorm(), d.rss, 1e-9 * d.rss);
+    }
   }
   // A term outside the factor widens it and still matches.
   const NestedFit wider = fitter->fitEquationError({"xi", "xi_diff"});

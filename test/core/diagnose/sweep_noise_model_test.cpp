@@ -101,7 +101,9 @@ TEST(SweepNoiseModel, ExplainRaisesRhoByOneStandardError) {
 TEST(SweepNoiseModel, WhiteNoiseAndTooFewPointsGiveWhite) {
   const ResidualNoiseModel white = noiseModelAlongSweep(ar1Blocks(0.0, 400, 8103, 0, 0, 0.0));
   // White or a coefficient within ~3 SE (0.025) of zero.
-  if (!white.ar.empty()) EXPECT_LT(std::abs(white.ar[0]), 0.08) << white.description;
+  if (!white.ar.empty()) {
+    EXPECT_LT(std::abs(white.ar[0]), 0.08) << white.description;
+  }
   const ResidualNoiseModel few = noiseModelAlongSweep(ar1Blocks(0.9, 6, 8104, 0, 0, 0.0));
   EXPECT_TRUE(few.ar.empty());
   EXPECT_NE(few.description.find("too few"), std::string::npos);

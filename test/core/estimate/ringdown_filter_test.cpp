@@ -86,10 +86,11 @@ TEST(RingdownFilter, TimeConstantAndOrderFromTheFloorNoise) {
       EXPECT_GT(f.n_samples, 1000);
       // The order is weakly identified (the shape of the first lags): one pole has the cusp at
       // lag 0, two poles a smooth start (taken as 2 to 4).
-      if (order == 1)
+      if (order == 1) {
         EXPECT_EQ(f.order, 1) << "T " << f.time_constant_s;
-      else
+      } else {
         EXPECT_GE(f.order, 2) << "T " << f.time_constant_s;
+      }
     }
   }
 }

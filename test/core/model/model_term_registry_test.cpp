@@ -44,7 +44,9 @@ TEST(ModelTermRegistry, EveryTermIsACandidateWhereItApplies) {
       EXPECT_TRUE(!c.forced || t->appliesTo(ExperimentMode::kForced)) << name;
     }
     // The base terms are always in the model; every other term is an extension explain tries.
-    if (name != "linear" && name != "controls") EXPECT_TRUE(own) << name << " is no candidate";
+    if (name != "linear" && name != "controls") {
+      EXPECT_TRUE(own) << name << " is no candidate";
+    }
   }
 }
 
