@@ -133,7 +133,10 @@ nlohmann::json ringdownExplanationToJson(const RingdownExplanation& x, double co
   j["unexplained"] = x.unexplained;
   j["adequate"] = x.adequate;
   j["causes"] = x.causes;
-  j["lack_of_fit"] = {{"test", x.lack_of_fit_test}, {"p_value", num(x.lack_of_fit_p)}};
+  j["lack_of_fit"] = {{"test", x.lack_of_fit_test},
+                      {"p_value", num(x.lack_of_fit_p)},
+                      {"rate_variation", num(x.lack_of_fit_rate_variation)},
+                      {"negative_law_rate_variation", num(x.negative_law_rate_variation)}};
   j["cause"] = x.cause;
   j["final"] = ringdownFitToJson(x.final_fit, x.segment, confidence, notes);
   j["final"]["model"] = x.selected.empty() ? "linear" : "linear+" + x.selected.front();

@@ -118,15 +118,24 @@ RingdownValue deltaValue(const std::function<double(const Eigen::VectorXd&)>& fn
   return v;
 }
 
-/// Q = c / rate with the interval mapped from the rate's (a rate interval reaching 0 gives +inf).
+/// Q = c / rate. The interval is the delta method on ln Q = ln c - ln rate (sd of ln Q = the
+/// rate's relative sd), with the rate's own quantile: positive and of nonzero width for every
+/// decaying fit, where mapping the rate's symmetric interval opened above as soon as it reached 0
+/// (a 35 dB decay with strongly correlated residuals and few effective samples printed
+/// [1.4e6, inf]). A rate that is not positive has no Q interval (-inf, inf).
 RingdownValue qFromRate(const RingdownValue& rate, double c) {
   RingdownValue q;
   q.value = c / rate.value;
   q.std = c * rate.std / (rate.value * rate.value);
   q.crb_std = c * rate.crb_std / (rate.value * rate.value);
-  q.ci_low = rate.ci_high > 0.0 ? c / rate.ci_high : kInf;
-  q.ci_high = rate.ci_low > 0.0 ? c / rate.ci_low : kInf;
-  if (rate.value <= 0.0) q.ci_low = -kInf, q.ci_high = kInf;
+  if (!(rate.value > 0.0)) {
+    q.ci_low = -kInf, q.ci_high = kInf;
+    return q;
+  }
+  const double z = rate.std > 0.0 ? (rate.ci_high - rate.value) / rate.std : 0.0;
+  const double half = z * rate.std / rate.value;  // half-width of ln Q's interval
+  q.ci_low = q.value * std::exp(-half);
+  q.ci_high = std::isfinite(half) ? q.value * std::exp(half) : kInf;
   return q;
 }
 

@@ -140,5 +140,38 @@ TEST(RingdownCauses, AddedTermsTestKeepsItsSizeWhenTheNoiseChangesAlongTheRecord
   EXPECT_GE(found, static_cast<int>(0.9 * reps));
 }
 
+/// A 50 dB ring-down (2000 samples, white 0.02 dB noise, no floor) whose level wobbles by
+/// `wobble_db` over 1.5 cycles along the decay: a breathing floor or a detector's ripple.
+RingdownEnvelope wobblingDecay(double wobble_db) {
+  std::mt19937 rng(31);
+  std::normal_distribution<double> g(0.0, 1.0);
+  RingdownEnvelope env;
+  env.frequency_hz = 5.0e3;
+  const double np = std::log(10.0) / 20.0;  // Np per dB
+  for (int i = 0; i < 2000; ++i) {
+    const double t = 0.01 * i;  // plateau 2 s, decay 2-20 s
+    const double u = std::max(0.0, t - 2.0) / 18.0;
+    const double db = t < 2.0 ? 0.0 : -50.0 * u + wobble_db * std::sin(3.0 * M_PI * u);
+    env.t_s.push_back(t);
+    env.log_amplitude.push_back(np * (db + 0.02 * g(rng)));
+  }
+  return env;
+}
+
+// The lack-of-fit test finds a 0.15 dB ripple on a 50 dB decay (p far below alpha), but the local
+// decay rate it implies wanders by about 2 % (RMS) of the mean: one Q describes the record, and
+// the verdict says both. A 3 dB ripple moves the rate by about 40 %: unexplained.
+TEST(RingdownCauses, ASignificantButSmallMisfitIsNotUnexplained) {
+  const RingdownExplanation small = explainRingdown(wobblingDecay(0.15));
+  EXPECT_LT(small.lack_of_fit_p, RingdownExplainOptions().alpha) << small.cause;
+  EXPECT_NEAR(small.lack_of_fit_rate_variation, 0.15 * 3.0 * M_PI / (std::sqrt(2.0) * 50.0), 0.01)
+      << small.cause;
+  EXPECT_FALSE(small.unexplained) << small.cause;
+  EXPECT_NE(small.cause.find("wanders by only"), std::string::npos) << small.cause;
+  const RingdownExplanation large = explainRingdown(wobblingDecay(3.0));
+  EXPECT_GT(large.lack_of_fit_rate_variation, 0.3) << large.cause;
+  EXPECT_TRUE(large.unexplained) << large.cause;
+}
+
 }  // namespace
 }  // namespace cvg_bench

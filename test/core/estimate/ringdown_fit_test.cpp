@@ -210,5 +210,37 @@ TEST(RingdownFit, TailBendingIntoAFastWanderingFloorIsLeftOut) {
   EXPECT_NEAR(f.derived.at("Q").value / q_true, 1.0, 0.03) << seg.why;
 }
 
+// A short decay under strongly correlated noise: the decay rate's interval reaches 0, and Q's
+// interval is still positive and closed, symmetric on ln Q with the rate's own quantile (the
+// delta method on ln Q; mapping the rate's interval opened it above, real record D012).
+TEST(RingdownFit, QIntervalIsClosedAndPositiveWhenTheRateIntervalReachesZero) {
+  std::mt19937 gen(5);
+  std::normal_distribution<double> e(0.0, 1.0);
+  RingdownEnvelope env;
+  env.frequency_hz = 1.0e4;
+  const double rate = 0.1;  // ln A per s: Q = pi f / rate = 3.14e5
+  double ar = 0.0;
+  for (int i = 0; i < 400; ++i) {
+    const double t = 0.05 * i;  // 20 s: plateau 2 s, then 16 dB of decay
+    ar = 0.995 * ar + 0.5 * std::sqrt(1.0 - 0.995 * 0.995) * e(gen);  // sd 0.5 Np
+    const double a = t < 2.0 ? 0.0 : -rate * (t - 2.0);
+    env.t_s.push_back(t);
+    env.log_amplitude.push_back(a + ar);
+  }
+  const RingdownSegment seg = segmentRingdown(env);
+  const RingdownFit f = fitRingdown(env, seg, "linear");
+  const RingdownValue& g = f.parameters.at("decay_rate_1_s");
+  const RingdownValue& q = f.derived.at("Q");
+  ASSERT_GT(g.value, 0.0);
+  ASSERT_LT(g.ci_low, 0.0) << "the case needs a rate interval that reaches 0";
+  EXPECT_GT(q.ci_low, 0.0);
+  EXPECT_TRUE(std::isfinite(q.ci_high));
+  EXPECT_LT(q.ci_low, q.value);
+  EXPECT_GT(q.ci_high, q.value);
+  const double z = (g.ci_high - g.value) / g.std;
+  EXPECT_NEAR(std::log(q.ci_high / q.value), z * g.std / g.value, 1e-9);
+  EXPECT_NEAR(std::log(q.value / q.ci_low), z * g.std / g.value, 1e-9);
+}
+
 }  // namespace
 }  // namespace cvg_bench
