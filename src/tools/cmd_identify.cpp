@@ -13,6 +13,7 @@
 #include "cvg_bench/core/demod/raw_record_demodulation.h"
 #include "cvg_bench/core/estimate/identify_pipeline.h"
 #include "cvg_bench/core/io/record_io.h"
+#include "cvg_bench/core/io/record_stacking.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
@@ -26,7 +27,7 @@ using report::writeJsonFile;
 namespace {
 
 const char* kHelp =
-    "usage: cvg_ident identify INPUT --mode free_decay|forced --model TERMS [--method "
+    "usage: cvg_ident identify INPUT [INPUT...] --mode free_decay|forced --model TERMS [--method "
     "ls|rls|ceres]\n"
     "                          [--confidence P] [--omega W] [--angular-gain K] [--mu MU]\n"
     "                          [--columns t=COL,f=COL,g=COL] [--json FILE]\n"
@@ -35,6 +36,9 @@ const char* kHelp =
     "           (free decay; demodulated first at --omega / the file's omega / estimated),\n"
     "           or a rosbag (.bag) of the project's SlowState / SweepPoint / RawSampleBatch "
     "messages\n"
+    "           Several free decays of one resonator (e.g. started at several pattern angles)\n"
+    "           are stacked for one fit: the equations across their joins are left out\n"
+    "           (--method ls or rls).\n"
     "  --topic  bag topic to read (default: the one topic of a project message type)\n"
     "  --columns  raw input with other column names or orders (as explain and demod)\n"
     "  --model  linear, or +-joined extensions (mu multiplies u~ bilinearly: LS cannot fit it):\n"
@@ -115,7 +119,7 @@ int runIdentify(const std::vector<std::string>& argv) {
     std::cout << withTermLists(kHelp);
     return 0;
   }
-  if (args.positionals().size() != 1) throw InputError("identify needs exactly one INPUT file");
+  if (args.positionals().empty()) throw InputError("identify needs an INPUT file");
   if (!args.has("mode")) throw InputError("--mode free_decay|forced is required");
   if (!args.has("model")) throw InputError("--model TERMS is required (e.g. linear, xi)");
   const std::string path = args.positionals().front();
@@ -132,21 +136,32 @@ int runIdentify(const std::vector<std::string>& argv) {
   RecordReadOptions ro;
   ro.repair_raw_timestamps = true;
   if (args.has("columns")) ro.raw_columns = parseRawColumnMap(args.get("columns"));
-  const AnyRecord any = readRecordInput(path, ro, args.get("topic"));
   std::vector<std::string> pre_notes;
   Estimate e;
   if (mode == ExperimentMode::kFreeDecay) {
-    if (any.kind == RecordKind::kForcedSweep)
-      throw InputError(path +
-                       ": holds a forced sweep (omega0 column) but --mode free_decay was "
-                       "given; use --mode forced");
-    SlowRecord rec = any.kind == RecordKind::kRaw
+    std::vector<SlowRecord> recs;
+    for (const std::string& file : args.positionals()) {
+      const AnyRecord any = readRecordInput(file, ro, args.get("topic"));
+      if (any.kind == RecordKind::kForcedSweep)
+        throw InputError(file +
+                         ": holds a forced sweep (omega0 column) but --mode free_decay was "
+                         "given; use --mode forced");
+      recs.push_back(any.kind == RecordKind::kRaw
                          ? demodulateRawRecord(any.raw, opt.omega_rad_s, pre_notes)
-                         : any.slow;
-    if (rec.source.empty()) rec.source = path;
+                         : any.slow);
+      if (recs.back().source.empty()) recs.back().source = file;
+    }
+    if (recs.size() > 1 && po.method == Method::kCeres)
+      throw InputError(
+          "--method ceres integrates one trajectory through the record; stacked free decays "
+          "(several INPUTs) are fitted with --method ls or rls");
+    SlowRecord rec = stackFreeDecays(recs, pre_notes);
     requireKnownOmega(opt.omega_rad_s, rec);
     e = identify(rec, po);
   } else {
+    if (args.positionals().size() != 1)
+      throw InputError("identify --mode forced takes one INPUT (several: free decays only)");
+    const AnyRecord any = readRecordInput(path, ro, args.get("topic"));
     if (any.kind == RecordKind::kFreeDecay)
       throw InputError(path +
                        ": holds a free-decay record (t column, no omega0) but --mode forced "
