@@ -53,7 +53,7 @@ const char* kExplainHelp =
     "A law), a beat of two close modes (split and both decay rates), a two-stage decay, the noise\n"
     "floor and drop-outs, and 'unexplained' when the rate changes without a physical law: the\n"
     "lack-of-fit test is significant at --alpha (1e-5) and the curve it adds moves the local\n"
-    "decay rate by more than --rate-variation (0.12, RMS) of the span's mean rate. Every\n"
+    "decay rate by more than --rate-variation (0.10, RMS) of the span's mean rate. Every\n"
     "fitted damping is sign-checked. --report DIR writes the data and (unless --no-figures) the\n"
     "figures: envelope in dB with the model and span, residuals, Q against amplitude.\n";
 
