@@ -585,7 +585,7 @@ class BadInputSuite(unittest.TestCase):
              ("mode",)),
             ("no --mode", ["identify", self.slow_path, "--model", "linear"], ("mode",)),
             ("no --model", ["identify", self.slow_path, "--mode", "free_decay"], ("model",)),
-            ("two inputs", slow + [self.slow_path], ()),
+            ("same input twice", slow + [self.slow_path], ("twice",)),
             ("unknown option", slow + ["--frobnicate", "1"], ("frobnicate",)),
             ("option without value", slow + ["--json"], ("json",)),
             ("option twice", slow + ["--omega", "85732", "--omega", "85732"], ("twice",)),

@@ -37,6 +37,11 @@ SlowRecord stackFreeDecays(const std::vector<SlowRecord>& records, std::vector<s
       throw InputError(nameOf(r, k) + ": omega " + std::to_string(w) + " rad/s differs from " +
                        nameOf(records.front(), 0) + "'s " + std::to_string(w0) +
                        " rad/s: records of one resonator only are stacked");
+    for (size_t j = 0; j < k; ++j)
+      if (!r.source.empty() && r.source == records[j].source)
+        throw InputError(r.source +
+                         ": given twice; a record counted twice would narrow every interval as if "
+                         "it were new data");
     step = std::max(step, medianStep(r));
   }
   SlowRecord out;

@@ -48,12 +48,14 @@ TEST(RecordStacking, JoinsAreGapsTheRegressionLeavesOut) {
   EXPECT_NE(notes.front().find("2 free decays stacked"), std::string::npos) << notes.front();
 }
 
-TEST(RecordStacking, RecordsOfAnotherFrequencyAreRefused) {
+TEST(RecordStacking, RecordsOfAnotherFrequencyOrGivenTwiceAreRefused) {
   std::vector<std::string> notes;
   SlowRecord b = decayAt(0.6, 2);
   b.omega_rad_s = 30001.0;
   EXPECT_THROW(stackFreeDecays({decayAt(0.0, 1), b}, notes), InputError);
   EXPECT_THROW(stackFreeDecays({}, notes), InputError);
+  const SlowRecord a = decayAt(0.0, 1);
+  EXPECT_THROW(stackFreeDecays({a, a}, notes), InputError);  // one source counted twice
 }
 
 // One decay along theta = 0 leaves the damping anisotropy's b_s (the axis at 45 deg of the pattern

@@ -15,7 +15,8 @@ namespace cvg_bench {
 /// (free_decay_regression.h: a step over 5x the median) leaves the equations across every join
 /// out. The natural frequencies must agree (relative 1e-9) or be unknown in all; extra columns are
 /// kept only when every record has them. `notes` gets one sentence saying what was joined.
-/// InputError (naming the record) on an empty list, an empty record or differing frequencies.
+/// InputError (naming the record) on an empty list, an empty record, differing frequencies or one
+/// source given twice.
 SlowRecord stackFreeDecays(const std::vector<SlowRecord>& records, std::vector<std::string>& notes,
                            double gap_steps = 20.0);
 
