@@ -57,8 +57,9 @@ std::string signCheck(const RingdownFit& f) {
 double curveRateVariation(const std::vector<double>& t, const std::vector<double>& curve,
                           double mean_rate) {
   const size_t n = t.size();
+  if (n < 3 || curve.size() != n) return 0.0;
   const double t0 = t.front(), span_s = t.back() - t0;
-  if (n < 3 || curve.size() != n || !(span_s > 0.0)) return 0.0;
+  if (!(span_s > 0.0)) return 0.0;
   if (!(mean_rate > 0.0)) return kInfinity;
   auto at = [&](double x) {  // linear interpolation between the samples
     const auto it = std::lower_bound(t.begin(), t.end(), x);

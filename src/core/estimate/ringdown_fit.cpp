@@ -134,8 +134,12 @@ RingdownValue qFromRate(const RingdownValue& rate, double c) {
   }
   const double z = rate.std > 0.0 ? (rate.ci_high - rate.value) / rate.std : 0.0;
   const double half = z * rate.std / rate.value;  // half-width of ln Q's interval
+  if (!(half >= 0.0) || !std::isfinite(half)) {   // no usable sd (infinite or NaN): unbounded
+    q.ci_low = 0.0, q.ci_high = kInf;
+    return q;
+  }
   q.ci_low = q.value * std::exp(-half);
-  q.ci_high = std::isfinite(half) ? q.value * std::exp(half) : kInf;
+  q.ci_high = q.value * std::exp(half);
   return q;
 }
 

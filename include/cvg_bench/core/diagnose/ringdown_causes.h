@@ -92,7 +92,8 @@ struct RingdownExplanation {
   bool adequate = false;  ///< final model fits, every damping positive
   std::string lack_of_fit_test;
   double lack_of_fit_p = 1.0;
-  /// Largest local decay-rate change the lack-of-fit curve shows, over the mean rate.
+  /// RMS local decay-rate change the lack-of-fit curve shows (middle 80 % of the span), over the
+  /// mean rate (RingdownLackOfFit::rate_variation).
   double lack_of_fit_rate_variation = 0.0;
   /// The same size for an amplitude law that fits only with a negative coefficient (how far its
   /// accelerating rate departs from the line's); 0 when there is none.
