@@ -13,7 +13,6 @@
 #include "cvg_bench/core/demod/raw_record_demodulation.h"
 #include "cvg_bench/core/estimate/identify_pipeline.h"
 #include "cvg_bench/core/io/record_io.h"
-#include "cvg_bench/core/io/record_stacking.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
@@ -151,13 +150,8 @@ int runIdentify(const std::vector<std::string>& argv) {
                          : any.slow);
       if (recs.back().source.empty()) recs.back().source = file;
     }
-    if (recs.size() > 1 && po.method == Method::kCeres)
-      throw InputError(
-          "--method ceres integrates one trajectory through the record; stacked free decays "
-          "(several INPUTs) are fitted with --method ls or rls");
-    SlowRecord rec = stackFreeDecays(recs, pre_notes);
-    requireKnownOmega(opt.omega_rad_s, rec);
-    e = identify(rec, po);
+    for (const SlowRecord& rec : recs) requireKnownOmega(opt.omega_rad_s, rec);
+    e = identify(recs, po);
   } else {
     if (args.positionals().size() != 1)
       throw InputError("identify --mode forced takes one INPUT (several: free decays only)");

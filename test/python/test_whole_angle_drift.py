@@ -94,7 +94,7 @@ class WholeAngleDrift(unittest.TestCase):
         est = os.path.join(self.tmp.name, "stacked.json")
         run(["identify"] + files + ["--mode", "free_decay", "--model", "xi", "--json", est], ok=(0, 1))
         with open(est) as f:
-            self.assertTrue(any("8 free decays stacked" in n for n in json.load(f)["notes"]))
+            self.assertTrue(any("8 records stacked into one regression" in n for n in json.load(f)["notes"]))
         j = self.measured(est, "stacked_drift.json")
         self.assertGreater(j["compensation_gain"], 10.0, j["rms_difference_deg_h"])
         p = run(["identify", files[0], files[1], "--mode", "forced", "--model", "xi"], ok=(2,))

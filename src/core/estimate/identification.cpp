@@ -574,6 +574,30 @@ std::vector<std::string> IdentificationOptions::validate() const {
 
 namespace {
 
+std::string recordName(const SlowRecord& r, size_t k) {
+  return r.source.empty() ? "record " + std::to_string(k + 1) : r.source;
+}
+
+/// Stacked free decays must be of one resonator (their natural frequencies agree to 1e-9, or are
+/// unknown in all)
+/// and each counted once: a record given twice would narrow every interval as if it were new data.
+void requireOneResonator(const std::vector<const SlowRecord*>& records) {
+  for (size_t k = 1; k < records.size(); ++k) {
+    const SlowRecord& r = *records[k];
+    for (size_t j = 0; j < k; ++j)
+      if (records[j] == records[k] || (!r.source.empty() && r.source == records[j]->source))
+        throw InputError(recordName(r, k) +
+                         ": given twice; a record counted twice would narrow every interval as if "
+                         "it were new data");
+    const double w0 = records.front()->omega_rad_s, w = r.omega_rad_s;
+    if (std::fabs(w - w0) > 1e-9 * std::max(std::fabs(w0), std::fabs(w)))
+      throw InputError(recordName(r, k) + ": omega " + fmt(w) + " rad/s differs from " +
+                       recordName(*records.front(), 0) + "'s " + fmt(w0) +
+                       " rad/s: only records of one resonator are stacked (raw records each get "
+                       "their own estimated frequency: give their common --omega)");
+  }
+}
+
 /// Free decay over records given by pointer (the single-record overload copies nothing).
 Estimate identifyFreeDecayRecords(const std::vector<const SlowRecord*>& records,
                                   const IdentificationOptions& options) {
@@ -588,6 +612,7 @@ Estimate identifyFreeDecayRecords(const std::vector<const SlowRecord*>& records,
   info.resonator = &model;
   info.omega_rad_s = resolveOmega(options.omega_rad_s, records[0]->omega_rad_s, false, "");
   info.noise_correlation = noiseCorrelationFromMetadata(records[0]->metadata);
+  requireOneResonator(records);
   std::vector<bool> simpson(records.size());
   for (size_t r = 0; r < records.size(); ++r) {
     const SlowRecord& rec = *records[r];
@@ -613,7 +638,9 @@ Estimate identifyFreeDecayRecords(const std::vector<const SlowRecord*>& records,
     }
   }
   if (records.size() > 1)
-    info.notes.push_back(std::to_string(records.size()) + " records stacked into one regression");
+    info.notes.push_back(std::to_string(records.size()) +
+                         " records stacked into one regression (each keeps its own time origin "
+                         "and lags; no equation joins two records)");
   const BlockStream stream = [&](const BlockSink& sink) {
     for (size_t r = 0; r < records.size(); ++r) {
       forEachValidatedFreeDecayBlock(model, *records[r], simpson[r], [&](const RegressionBlock& b) {

@@ -85,6 +85,16 @@ Estimate identify(const SlowRecord& record, const PipelineOptions& options) {
   return refine(record, identifyFreeDecay(record, regressionOptions(options)), options);
 }
 
+Estimate identify(const std::vector<SlowRecord>& records, const PipelineOptions& options) {
+  if (records.size() == 1) return identify(records.front(), options);
+  throwIfInvalid("invalid identification options", options.validate());
+  if (options.method == Method::kCeres)
+    throw InputError(
+        "--method ceres integrates one trajectory through the record; stacked free decays "
+        "(several records) are fitted with --method ls or rls");
+  return identifyFreeDecay(records, regressionOptions(options));
+}
+
 DeferredEstimate identifyDeferred(const SlowRecord& record, const PipelineOptions& options) {
   throwIfInvalid("invalid identification options", options.validate());
   DeferredEstimate d;

@@ -70,7 +70,9 @@ struct IdentificationOptions {
 /// equations for the model, NaN/Inf, non-increasing times, constant data, bad options).
 Estimate identifyFreeDecay(const SlowRecord& record, const IdentificationOptions& options);
 /// Several records stacked into one regression (e.g. runs at different pattern angles,
-/// docs/paper.md item 11); each record keeps its own time origin and lag structure.
+/// docs/paper.md item 11); each record keeps its own time origin, integration rule and lag
+/// structure, and no equation joins two records. InputError also when the records' natural
+/// frequencies differ (relative 1e-9; unknown in all is allowed) or one record is given twice.
 Estimate identifyFreeDecay(const std::vector<SlowRecord>& records,
                            const IdentificationOptions& options);
 

@@ -61,6 +61,11 @@ struct PipelineOptions {
 /// Free-decay identification of one record. InputError for bad input or options; AnalysisError
 /// when Ceres finds no usable solution and on_ceres_failure is kThrow.
 Estimate identify(const SlowRecord& record, const PipelineOptions& options);
+/// Several free decays of one resonator in one fit (e.g. decays started at several pattern angles,
+/// which bound the anisotropies' two axes better than one: docs/validation_drift.md), by the
+/// stacked regression identifyFreeDecay(std::vector); one record is identify(record). InputError
+/// for method kCeres with several records (the output-error fit integrates one trajectory).
+Estimate identify(const std::vector<SlowRecord>& records, const PipelineOptions& options);
 /// The same with the free-decay refinement's covariance deferred (explain ranks many refined fits
 /// and reports few): `estimate` is FreeDecayRefinement::solved() (values, sigma, rank, dof; no
 /// intervals) and `finish` returns what identify() returns; with another method, or when the
