@@ -243,6 +243,21 @@ ParameterFile parameterFileFromJson(nlohmann::json j, const std::string& path) {
     throw InputError(path +
                      ": needs an object member \"parameters\" (identify --json) or "
                      "\"final\" (explain --json)");
+  // A rank-deficient estimate (identify exit 1, explain "does not determine"): its values along the
+  // null space are arbitrary, so a drift or Q from it would be a number that means nothing (#25).
+  if (j.contains("rank") && j["rank"].is_number_integer() && j.contains("n_params") &&
+      j["n_params"].is_number_integer() && j["rank"].get<long>() < j["n_params"].get<long>()) {
+    std::string list;
+    if (j.contains("unidentifiable") && j["unidentifiable"].is_array())
+      for (const auto& u : j["unidentifiable"])
+        if (u.is_string()) list += (list.empty() ? "" : ", ") + u.get<std::string>();
+    throw InputError(path + ": the estimate is rank-deficient (rank " +
+                     std::to_string(j["rank"].get<long>()) + " of " +
+                     std::to_string(j["n_params"].get<long>()) +
+                     (list.empty() ? "" : "; not identified: " + list) +
+                     "): the record does not determine its parameters, so no drift or Q follows "
+                     "from it; identify from a longer record or several decays");
+  }
   if (!j.contains("omega") || !j["omega"].is_number())
     throw InputError(path + ": needs a number member \"omega\" (natural frequency, rad/s)");
   f.omega_rad_s = j["omega"].get<double>();

@@ -132,6 +132,7 @@ nlohmann::json explanationToJson(const Explanation& x) {
                             {"terms", x.selection.runner_up.terms},
                             {"delta_criterion", finiteOrNull(x.selection.runner_up_delta)}});
   j["unexplained"] = x.unexplained;
+  j["determined"] = x.determined;
   j["lack_of_fit"] = {{"test", x.lack_of_fit.test},
                       {"p_value", x.lack_of_fit.p_value},
                       {"worst", x.lack_of_fit.worst},

@@ -153,6 +153,13 @@ int runExplain(const std::vector<std::string>& argv) {
     if (!args.has("no-figures") && runExplainReportScript(dir))
       std::cout << "report: " << dir << "/report.md\n";
   }
+  if (!x.determined) {
+    // The files are written (they say why), but no usable model: exit 1, as identify (#25).
+    std::cerr << "cvg_ident explain: analysis failed: the record does not determine the model ("
+              << x.finalEstimate().rank << " of " << x.finalEstimate().n_params
+              << " parameters; see the verdict)\n";
+    return 1;
+  }
   return 0;
 }
 

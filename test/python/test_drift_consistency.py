@@ -34,6 +34,24 @@ class DriftConsistency(unittest.TestCase):
     def path(self, name):
         return os.path.join(self.tmp.name, name)
 
+    def test_a_rank_deficient_estimate_gives_no_drift(self):
+        # identify exits 1 on a record that does not determine the model; its JSON is still
+        # written, and drift of it is refused (exit 2, the null space named), never a Q or rate
+        # from arbitrary values along the null space (issue #25).
+        full = self.path("full.json")
+        run(["identify", self.rec, "--mode", "free_decay", "--model", "linear", "--json", full])
+        with open(full) as f:
+            j = json.load(f)
+        j["rank"] = j["n_params"] - 2
+        j["unidentifiable"] = ["gamma", "b_c"]
+        bad = self.path("rank_deficient.json")
+        with open(bad, "w") as f:
+            json.dump(j, f)
+        p = run(["drift", "--params", bad], ok=(2,))
+        self.assertIn("rank-deficient", p.stderr)
+        self.assertIn("gamma, b_c", p.stderr)
+        run(["drift", "--params", full, "--theta-grid", "4"])  # the full-rank one still works
+
     def test_drift_reports_the_estimates_q(self):
         run(["identify", self.rec, "--mode", "free_decay", "--model", "gamma_nl", "--json", self.path("id.json")],
             ok=(0, 1))

@@ -45,6 +45,43 @@ class FoucaultRawRecord(unittest.TestCase):
         with open(out) as f:
             return json.load(f), p.stdout
 
+    def test_a_short_swing_gives_no_model_and_no_drift(self):
+        # 62 s from the middle of the swing (22 periods, 20 slow samples): the linear model is
+        # rank-deficient there. Before: explain exited 0, "the linear model is adequate", and
+        # drift on its JSON printed Q = -22 and 12,000 deg/h (issue #25, a short swing).
+        m = (self.t >= 700.0) & (self.t <= 762.0)
+        short = os.path.join(self.tmp.name, "short62.csv")
+        write_tfg(short, self.t[m] - 700.0, self.x[m], self.y[m])
+        out = os.path.join(self.tmp.name, "short62.json")
+        p = run(["explain", short, "--mode", "free_decay", "--json", out])
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        self.assertIn("does not determine", p.stderr)
+        self.assertNotIn("is adequate", p.stdout)
+        with open(out) as f:
+            j = json.load(f)
+        self.assertFalse(j["determined"])
+        self.assertIn("does not determine", j["cause"])
+        d = run(["drift", "--params", out])
+        self.assertEqual(d.returncode, 2, d.stdout)
+        self.assertIn("rank-deficient", d.stderr)
+        # The same 62 s at the record's own clock (t from 700 s) fit with full rank: then Q is
+        # printed with the interval of a 1.4 % amplitude fall, which contains the whole record's
+        # Q (~4,900) and spans a factor of more than 10 - honest, not a confident wrong answer.
+        same = os.path.join(self.tmp.name, "short62_abs.csv")
+        write_tfg(same, self.t[m], self.x[m], self.y[m])
+        out2 = os.path.join(self.tmp.name, "short62_abs.json")
+        p2 = run(["explain", same, "--mode", "free_decay", "--json", out2])
+        with open(out2) as f:
+            j2 = json.load(f)
+        if p2.returncode == 0:
+            q = j2["final"]["derived_ci"]["Q"]
+            self.assertLess(q["ci_low"], 4900.0)
+            self.assertGreater(q["ci_high"], 4900.0)
+            self.assertGreater(q["ci_high"] / q["ci_low"], 10.0)
+        else:
+            self.assertEqual(p2.returncode, 1, p2.stderr)
+            self.assertFalse(j2["determined"])
+
     def test_start_up_glitch_left_out_and_verdict_as_on_the_trimmed_track(self):
         raw, text = self.explain(DATA, ["--columns", COLUMNS])
         self.assertIn("the first 5 sample(s) left out (start-up glitch)", text)

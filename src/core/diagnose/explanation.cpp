@@ -166,6 +166,19 @@ std::string verdict(const Explanation& x, ExperimentMode mode, const ExplainOpti
     o << " Runner-up: " << sel.runner_up.model << ", criterion " << num(sel.runner_up_delta, 3)
       << (sel.runner_up_delta >= 0 ? " worse" : " better but not confirmed by the hold-out") << ".";
   o << amplitudeTimeCaveat(x, mode);
+  const Estimate& fe = x.finalEstimate();
+  if (fe.rank < fe.n_params) {
+    // Issue #25: a model the record does not determine is no answer (a 62 s cut of a pendulum
+    // swing: rank 6 of 8, then Q -22 and 12,000 deg/h downstream).
+    std::string list;
+    for (const auto& u : fe.unidentifiable) list += (list.empty() ? "" : ", ") + u;
+    o << " The record does not determine the " << (sel.selected.empty() ? "linear" : "final")
+      << " model: rank " << fe.rank << " of " << fe.n_params
+      << (list.empty() ? "" : " (not identified: " + list + ")")
+      << "; its parameters, Q and drift are not estimates. A longer record (more periods) or "
+         "decays at other pattern angles are needed.";
+    return o.str();
+  }
   if (x.unexplained) {
     const LackOfFit& l = x.lack_of_fit;
     const bool slow = l.low_frequency_p_value < l.runs_p_value;
@@ -234,6 +247,7 @@ Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
     lof.noise_model = x.noise_model.description;
     lof.p_value = lof.p_value_unwhitened = lof.runs_p_value = lof.low_frequency_p_value = 0.0;
     x.unexplained = true;
+    x.determined = x.finalEstimate().rank >= x.finalEstimate().n_params;
     x.notes.push_back("adequacy: " + lof.test + "; the verdict is unexplained");
     // The p-values of 0 stand for "no adequacy"; the cause says so instead of quoting them.
     x.cause = "The final model " + x.selection.final_fit.model +
@@ -294,6 +308,7 @@ Explanation explainWith(const NestedModelFitter& fitter, ExperimentMode mode,
       (mode == ExperimentMode::kForced && lof.signature_p_value < options.lack_of_fit_alpha);
   x.notes.push_back("hold-out: " + x.selection.holdout_description);
   x.notes.push_back("adequacy noise model: " + x.noise_model.description);
+  x.determined = x.finalEstimate().rank >= x.finalEstimate().n_params;
   x.cause = verdict(x, mode, options);
   return x;
 }

@@ -75,8 +75,11 @@ struct Explanation {
   ResidualNoiseModel noise_model;     ///< under which the adequacy is tested
   LackOfFit lack_of_fit;              ///< of the final model
   bool unexplained = false;           ///< structure remains that no accepted extension removes
-  std::string cause;                  ///< the verdict in words
-  std::vector<std::string> notes;     ///< provenance and skipped candidates
+  /// The final estimate has full rank: the record determines the model's parameters. False: its
+  /// parameters, Q and drift are not estimates (the verdict says so; cvg_ident exits 1).
+  bool determined = true;
+  std::string cause;               ///< the verdict in words
+  std::vector<std::string> notes;  ///< provenance and skipped candidates
   /// Free decay: what the record shows before any model, beside the final model's drift
   /// prediction (orbit_reading.h); not valid in forced mode.
   OrbitReading measured;
