@@ -289,6 +289,37 @@ DriftRate driftRateToMsg(double r, double k, double theta_rad, const ParameterEs
   return msg;
 }
 
+DriftMeasured driftComparisonToMsg(const DriftComparison& c, double confidence,
+                                   const ros::Time& stamp) {
+  constexpr double kDegH = 180.0 / M_PI * 3600.0;
+  const double nan = std::nan("");
+  DriftMeasured msg;
+  msg.header.stamp = stamp;
+  msg.model = c.model;
+  msg.r = c.r;
+  msg.k = c.k;
+  msg.walk_deg_h = c.walk_rad_s * kDegH;
+  msg.confidence = confidence;
+  for (const DriftBin& b : c.bins) {
+    msg.theta_deg.push_back(b.theta_rad * 180.0 / M_PI);
+    msg.measured_ok.push_back(b.measured_ok);
+    msg.measured_deg_h.push_back(b.measured_ok ? b.measured.value * kDegH : nan);
+    msg.measured_ci_low_deg_h.push_back(b.measured_ok ? b.measured.ci_low * kDegH : nan);
+    msg.measured_ci_high_deg_h.push_back(b.measured_ok ? b.measured.ci_high * kDegH : nan);
+    msg.predicted_deg_h.push_back(b.predicted.value * kDegH);
+    msg.predicted_ci_low_deg_h.push_back(b.predicted.ci_low * kDegH);
+    msg.predicted_ci_high_deg_h.push_back(b.predicted.ci_high * kDegH);
+    msg.passes.push_back(static_cast<uint32_t>(b.passes));
+  }
+  msg.rms_measured_deg_h = c.rms_measured_rad_s * kDegH;
+  msg.rms_difference_deg_h = c.rms_difference_rad_s * kDegH;
+  msg.compensation_gain =
+      c.rms_difference_rad_s > 0.0 ? c.rms_measured_rad_s / c.rms_difference_rad_s : nan;
+  msg.bins_measured = static_cast<uint32_t>(c.bins_measured);
+  msg.summary = c.summary;
+  return msg;
+}
+
 SimulationTruth truthToMsg(const std::string& preset, const std::string& mode,
                            const std::string& model, double omega_rad_s, double mu,
                            const std::vector<std::string>& names,

@@ -78,6 +78,11 @@ IdentifierNode::IdentifierNode(const ros::NodeHandle& nh, const ros::NodeHandle&
     data_sub_ = nh_.subscribe("sweep", options_.queue_size, &IdentifierNode::onSweep, this);
   truth_sub_ = nh_.subscribe("truth", 10, &IdentifierNode::onTruth, this);
   loss_sub_ = nh_.subscribe("input_loss", 100, &IdentifierNode::onInputLoss, this);
+  // A whole-angle run arrives as a burst of states (thousands a second): its own deep queue, and
+  // sequence gaps counted (WholeAngleRunBuffer::lost) rather than a silently shorter run.
+  whole_angle_sub_ = nh_.subscribe("whole_angle", std::max(options_.queue_size, 100000),
+                                   &IdentifierNode::onWholeAngle, this);
+  drift_measured_pub_ = nh_.advertise<DriftMeasured>("drift_measured", 2, /*latch=*/true);
   // Services on their own thread: a solve they ask for does not hold up the data callbacks.
   ros::NodeHandle services(nh_);
   services.setCallbackQueue(&service_queue_);
@@ -88,6 +93,8 @@ IdentifierNode::IdentifierNode(const ros::NodeHandle& nh, const ros::NodeHandle&
       services.advertiseService("predict_drift", &IdentifierNode::onPredictDrift, this);
   reset_srv_ = services.advertiseService("identifier/reset", &IdentifierNode::onReset, this);
   explain_srv_ = services.advertiseService("explain", &IdentifierNode::onExplain, this);
+  measure_drift_srv_ =
+      services.advertiseService("measure_drift", &IdentifierNode::onMeasureDrift, this);
   timer_ = nh_.createWallTimer(ros::WallDuration(0.05), &IdentifierNode::onTimer, this);
   reconfigure_.reset(new dynamic_reconfigure::Server<IdentifierConfig>(pnh));
   reconfigure_->setCallback(
@@ -805,6 +812,9 @@ void IdentifierNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat)
   stat.add("stale_solves_discarded", stale_solves_);
   stat.add("solver", last_solver_message_);
   stat.add("suspect_estimates", suspect_estimates_);
+  stat.add("whole_angle_states", whole_angle_.size());
+  stat.add("whole_angle_dropped", whole_angle_.dropped());
+  stat.add("whole_angle_lost", whole_angle_.lost());
   for (size_t i = 0; i < last_sanity_problems_.size(); ++i)
     stat.add("sanity_problem_" + std::to_string(i + 1), last_sanity_problems_[i]);
 }
@@ -845,6 +855,57 @@ bool IdentifierNode::onPredictDrift(PredictDrift::Request& req, PredictDrift::Re
     res.success = false;
     res.message = e.what();
     res.rates.clear();
+  }
+  return true;
+}
+
+void IdentifierNode::onWholeAngle(const SlowState::ConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  try {
+    const Eigen::Vector4d q = slowFromMsg(*msg);
+    if (!whole_angle_.add(msg->phase_epoch, msg->header.stamp, msg->header.seq, q,
+                          msg->reference_frequency_rad_s - msg->detuning_rad_s))
+      ROS_WARN_THROTTLE(5.0,
+                        "identifier: whole-angle state out of order or over the limit "
+                        "dropped (%llu so far)",
+                        static_cast<unsigned long long>(whole_angle_.dropped()));
+  } catch (const InputError& e) {
+    ROS_WARN_THROTTLE(5.0, "identifier: whole-angle state dropped: %s", e.what());
+  }
+}
+
+bool IdentifierNode::onMeasureDrift(MeasureDrift::Request& req, MeasureDrift::Response& res) {
+  try {
+    requireFinite(req.walk_rad_s, "walk_rad_s");
+    if (req.bins != 0 && (req.bins < 4 || req.bins > 3600))
+      throw InputError("bins: need 4..3600 theta bins (0 = 24)");
+    SlowRecord run;
+    UncertainParameters params;
+    uint64_t lost = 0;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!have_estimate_) throw InputError("no estimate yet: identify a free decay first");
+      if (whole_angle_.size() == 0)
+        throw InputError("no whole-angle run received on " + whole_angle_sub_.getTopic());
+      run = whole_angle_.record();
+      lost = whole_angle_.lost();
+      params = uncertainParameters(estimate_);
+    }
+    // Measured outside the lock: the data callbacks go on meanwhile.
+    const DriftComparison c = measureDrift(
+        run, req.walk_rad_s, params, req.bins ? static_cast<int>(req.bins) : 24, params.confidence);
+    res.comparison = driftComparisonToMsg(c, params.confidence, ros::Time::now());
+    res.comparison.header.frame_id = options_.frame_id;
+    drift_measured_pub_.publish(res.comparison);
+    res.success = true;
+    res.message = c.summary + " (" + std::to_string(run.size()) + " states of the run" +
+                  (lost ? ", " + std::to_string(lost) + " lost in transport" : "") + ")";
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = e.what();
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (whole_angle_.lost())
+      res.message += " (" + std::to_string(whole_angle_.lost()) + " states lost in transport)";
   }
   return true;
 }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 #include "cvg_bench/RawSampleBatch.h"
 #include "cvg_bench/SimulationTruth.h"
@@ -11,6 +12,7 @@
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/experiment_runner.h"
 #include "cvg_bench/core/simulate/measurement_noise.h"
+#include "cvg_bench/core/simulate/whole_angle_simulator.h"
 #include "cvg_bench/ros/conversions.h"
 
 namespace cvg_bench {
@@ -41,6 +43,9 @@ SimulatorNode::SimulatorNode(const ros::NodeHandle& nh, const ros::NodeHandle& p
   start_free_decay_srv_ =
       nh_.advertiseService("start_free_decay", &SimulatorNode::onStartFreeDecay, this);
   start_sweep_srv_ = nh_.advertiseService("start_sweep", &SimulatorNode::onStartSweep, this);
+  whole_angle_pub_ = nh_.advertise<SlowState>("sim/whole_angle", 10000);
+  start_whole_angle_srv_ =
+      nh_.advertiseService("start_whole_angle", &SimulatorNode::onStartWholeAngle, this);
   timer_ = nh_.createWallTimer(ros::WallDuration(1.0 / options_.publish_rate_hz),
                                &SimulatorNode::onTick, this);
   ROS_INFO("resonator simulator: preset '%s' (%s), omega = %.6g rad/s", preset_.name.c_str(),
@@ -163,6 +168,45 @@ void SimulatorNode::startFreeDecay(double duration_s, int seed, const OrbitEleme
            raw_stream_ ? raw_stream_->total() : size_t(0), slow_.size());
 }
 
+bool SimulatorNode::onStartWholeAngle(StartWholeAngle::Request& req,
+                                      StartWholeAngle::Response& res) {
+  try {
+    WholeAngleOptions o;
+    for (double v :
+         {req.duration_s, req.amplitude, req.quadrature, req.walk_rad_s, req.loop_rate_1_s})
+      requireFinite(v, "start_whole_angle request");
+    if (req.duration_s > options_.max_duration_s)
+      throw InputError("duration_s = " + std::to_string(req.duration_s) +
+                       " s exceeds max_duration_s = " + std::to_string(options_.max_duration_s) +
+                       " s");
+    o.duration_s = req.duration_s;
+    if (req.amplitude != 0.0) o.r0 = req.amplitude;
+    o.k0 = req.quadrature;
+    o.walk_rad_s = req.walk_rad_s;
+    o.loop_rate_1_s = req.loop_rate_1_s;
+    o.seed = req.seed > 0 ? req.seed : static_cast<std::uint64_t>(options_.seed);
+    running_ = Running::kNone;
+    // The core's run (the one `cvg_ident simulate --mode whole_angle` writes), streamed like a
+    // free decay's slow states but on its own topic.
+    slow_ = simulateWholeAngle(preset_, o);
+    slow_truth_ = SlowRecord();
+    raw_stream_.reset();
+    sweep_ = SweepRecord();
+    beginStreaming(Running::kWholeAngle, ExperimentMode::kFreeDecay, preset_);
+    res.walk_rad_s = std::strtod(slow_.metadata.at("whole_angle_walk_rad_s").c_str(), nullptr);
+    res.n_slow_states = static_cast<uint32_t>(slow_.size());
+    res.success = true;
+    res.message = "whole-angle run started: " + std::to_string(slow_.size()) +
+                  " slow states over " + std::to_string(slow_.t_s.back()) + " s on sim/whole_angle";
+    ROS_INFO("%s", res.message.c_str());
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = e.what();
+    ROS_ERROR("start_whole_angle refused: %s", e.what());
+  }
+  return true;
+}
+
 void SimulatorNode::startSweep(const ResonatorPreset& preset, int seed) {
   running_ = Running::kNone;
   const ExperimentRunner runner(preset);
@@ -212,7 +256,8 @@ void SimulatorNode::onTick(const ros::WallTimerEvent&) {
   if (running_ == Running::kNone) return;
   const double wall_elapsed = (ros::WallTime::now() - wall_start_).toSec();
   if (wall_elapsed < 0.0) return;
-  if (running_ == Running::kFreeDecay) publishDueFreeDecay(wall_elapsed * options_.realtime_factor);
+  if (running_ == Running::kFreeDecay || running_ == Running::kWholeAngle)
+    publishDueFreeDecay(wall_elapsed * options_.realtime_factor);
   if (running_ == Running::kSweep) publishDueSweep(wall_elapsed);
 }
 
@@ -244,7 +289,7 @@ void SimulatorNode::publishDueFreeDecay(double due_s) {
     const ros::Time stamp = timeAfter(start_stamp_, slow_.t_s[slow_next_]);
     SlowState s = slowStateToMsg(slow_.q[slow_next_], stamp, start_stamp_, preset_.omega_rad_s);
     s.header.frame_id = options_.frame_id;
-    slow_pub_.publish(s);
+    (running_ == Running::kWholeAngle ? whole_angle_pub_ : slow_pub_).publish(s);
     if (slow_next_ < slow_truth_.size()) {
       SlowState t =
           slowStateToMsg(slow_truth_.q[slow_next_], stamp, start_stamp_, preset_.omega_rad_s);
@@ -256,8 +301,9 @@ void SimulatorNode::publishDueFreeDecay(double due_s) {
   if ((!raw_stream_ || raw_stream_->produced() >= raw_stream_->total()) &&
       slow_next_ >= slow_.size()) {
     if (raw_stream_) publishEndOfRawRecord();
+    ROS_INFO("%s finished (%.6g s simulated)",
+             running_ == Running::kWholeAngle ? "whole-angle run" : "free decay", due_s);
     running_ = Running::kNone;
-    ROS_INFO("free decay finished (%.6g s simulated)", due_s);
   }
 }
 
@@ -294,10 +340,11 @@ void SimulatorNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) 
   const double raw_rate = dt > 0.0 ? (raw_published_ - raw_at_last_diag_) / dt : 0.0;
   last_diag_wall_ = now;
   raw_at_last_diag_ = raw_published_;
-  const char* state = running_ == Running::kFreeDecay ? "free decay"
-                      : running_ == Running::kSweep   ? "forced sweep"
-                      : experiments_ > 0              ? "finished"
-                                                      : "idle";
+  const char* state = running_ == Running::kFreeDecay    ? "free decay"
+                      : running_ == Running::kSweep      ? "forced sweep"
+                      : running_ == Running::kWholeAngle ? "whole-angle run"
+                      : experiments_ > 0                 ? "finished"
+                                                         : "idle";
   // Behind by more than two ticks of simulated time: the requested real-time factor is not met.
   const double tick_s = options_.realtime_factor / options_.publish_rate_hz;
   if (running_ == Running::kFreeDecay && lag_s_ > 2.0 * tick_s)

@@ -235,5 +235,35 @@ TEST(Conversions, TruthKeepsModelOrder) {
   EXPECT_DOUBLE_EQ(truthValuesFromMsg(msg).at("nu"), 2.0);
 }
 
+// The measured-against-predicted drift in deg/h per bin; a bin with no usable pass has NaN
+// measured fields (never a 0 that would read as "no drift").
+TEST(Conversions, DriftComparisonInDegreesPerHourWithUnmeasuredBinsNaN) {
+  DriftComparison c;
+  c.bins.resize(2);
+  c.bins[0].theta_rad = -M_PI / 4;
+  c.bins[0].measured_ok = true;
+  c.bins[0].measured.value = 1e-4;
+  c.bins[0].measured.ci_low = 0.5e-4;
+  c.bins[0].measured.ci_high = 1.5e-4;
+  c.bins[0].predicted.value = 2e-4;
+  c.bins[0].passes = 3;
+  c.bins[1].theta_rad = 0.0;
+  c.rms_measured_rad_s = 4e-4;
+  c.rms_difference_rad_s = 1e-4;
+  c.bins_measured = 1;
+  const DriftMeasured m = driftComparisonToMsg(c, 0.95, ros::Time(5.0));
+  const double dh = 180.0 / M_PI * 3600.0;
+  ASSERT_EQ(m.theta_deg.size(), 2u);
+  EXPECT_DOUBLE_EQ(m.theta_deg[0], -45.0);
+  EXPECT_DOUBLE_EQ(m.measured_deg_h[0], 1e-4 * dh);
+  EXPECT_DOUBLE_EQ(m.measured_ci_high_deg_h[0], 1.5e-4 * dh);
+  EXPECT_DOUBLE_EQ(m.predicted_deg_h[0], 2e-4 * dh);
+  EXPECT_EQ(m.passes[0], 3u);
+  EXPECT_FALSE(m.measured_ok[1]);
+  EXPECT_TRUE(std::isnan(m.measured_deg_h[1]));
+  EXPECT_DOUBLE_EQ(m.compensation_gain, 4.0);
+  EXPECT_EQ(m.bins_measured, 1u);
+}
+
 }  // namespace
 }  // namespace cvg_bench

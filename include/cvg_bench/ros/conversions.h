@@ -16,12 +16,14 @@
 #include <vector>
 
 #include "cvg_bench/DerivedQuantitiesStamped.h"
+#include "cvg_bench/DriftMeasured.h"
 #include "cvg_bench/DriftRate.h"
 #include "cvg_bench/ModelEstimate.h"
 #include "cvg_bench/RawSampleBatch.h"
 #include "cvg_bench/SimulationTruth.h"
 #include "cvg_bench/SlowState.h"
 #include "cvg_bench/SweepPoint.h"
+#include "cvg_bench/core/diagnose/drift_measurement.h"
 #include "cvg_bench/core/estimate/estimate.h"
 #include "cvg_bench/core/io/records.h"
 
@@ -85,6 +87,10 @@ DerivedQuantitiesStamped derivedToMsg(const std::map<std::string, ParameterEstim
 /// A drift rate (5.9) with its interval at (r, k, theta).
 DriftRate driftRateToMsg(double r, double k, double theta_rad, const ParameterEstimate& rate,
                          double confidence, const ros::Time& stamp);
+
+/// Measured against predicted drift of a whole-angle run (core measureDrift), in deg/h.
+DriftMeasured driftComparisonToMsg(const DriftComparison& c, double confidence,
+                                   const ros::Time& stamp);
 
 // ---------------------------------------------------------------- simulator truth
 

@@ -42,6 +42,7 @@
 #include "cvg_bench/IdentifierConfig.h"
 #include "cvg_bench/Identify.h"
 #include "cvg_bench/InputLoss.h"
+#include "cvg_bench/MeasureDrift.h"
 #include "cvg_bench/ModelEstimate.h"
 #include "cvg_bench/PredictDrift.h"
 #include "cvg_bench/SimulationTruth.h"
@@ -53,6 +54,7 @@
 #include "cvg_bench/ros/experiment_tracker.h"
 #include "cvg_bench/ros/identifier_node_options.h"
 #include "cvg_bench/ros/streaming_free_decay_rls.h"
+#include "cvg_bench/ros/whole_angle_run_buffer.h"
 
 namespace cvg_bench {
 
@@ -109,6 +111,11 @@ class IdentifierNode {
   bool onIdentify(Identify::Request& req, Identify::Response& res);
   bool onGetEstimate(GetEstimate::Request& req, GetEstimate::Response& res);
   bool onPredictDrift(PredictDrift::Request& req, PredictDrift::Response& res);
+  /// A whole-angle run's state (`whole_angle`): buffered apart from the identification window.
+  void onWholeAngle(const SlowState::ConstPtr& msg);
+  /// Measured against predicted drift of the buffered whole-angle run (core measureDrift, as
+  /// `cvg_ident drift --measured`), also published on `drift_measured`.
+  bool onMeasureDrift(MeasureDrift::Request& req, MeasureDrift::Response& res);
   bool onReset(std_srvs::Trigger::Request& req, std_srvs::Trigger::Response& res);
   bool onExplain(Explain::Request& req, Explain::Response& res);
 
@@ -135,9 +142,11 @@ class IdentifierNode {
   ros::NodeHandle nh_;
   IdentifierNodeOptions options_;
   ExperimentMode mode_;
-  ros::Subscriber data_sub_, truth_sub_;
-  ros::Publisher estimate_pub_, derived_pub_, drift_pub_, markers_pub_;
-  ros::ServiceServer identify_srv_, get_estimate_srv_, predict_drift_srv_, reset_srv_, explain_srv_;
+  ros::Subscriber data_sub_, truth_sub_, whole_angle_sub_;
+  ros::Publisher estimate_pub_, derived_pub_, drift_pub_, markers_pub_, drift_measured_pub_;
+  ros::ServiceServer identify_srv_, get_estimate_srv_, predict_drift_srv_, reset_srv_, explain_srv_,
+      measure_drift_srv_;
+  WholeAngleRunBuffer whole_angle_;
   ros::WallTimer timer_;
   tf2_ros::TransformBroadcaster tf_;
   diagnostic_updater::Updater diagnostics_;

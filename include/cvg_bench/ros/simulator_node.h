@@ -5,7 +5,9 @@
 //   sim/slow_truth  SlowState       the same without noise
 //   sweep           SweepPoint      settled points of a forced sweep, with noise
 //   truth           SimulationTruth latched: preset, true parameters, noise levels
-// Services start_free_decay and start_sweep start an experiment (the previous one stops).
+//   sim/whole_angle SlowState       a whole-angle run (loops hold r and k, theta free), with noise
+// Services start_free_decay, start_sweep and start_whole_angle start an experiment (the previous
+// one stops).
 // Stamps are start + simulated time; the start is the phase epoch of (2.4). The raw record is
 // produced piece by piece as it becomes due (RawFreeDecayStream), at most max_batch_samples a
 // tick: a node that cannot keep up lags (reported in the diagnostics) instead of growing.
@@ -19,6 +21,7 @@
 
 #include "cvg_bench/StartFreeDecay.h"
 #include "cvg_bench/StartSweep.h"
+#include "cvg_bench/StartWholeAngle.h"
 #include "cvg_bench/core/io/records.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/resonator_preset.h"
@@ -33,10 +36,11 @@ class SimulatorNode {
   SimulatorNode(const ros::NodeHandle& nh, const ros::NodeHandle& pnh);
 
  private:
-  enum class Running { kNone, kFreeDecay, kSweep };
+  enum class Running { kNone, kFreeDecay, kSweep, kWholeAngle };
 
   bool onStartFreeDecay(StartFreeDecay::Request& req, StartFreeDecay::Response& res);
   bool onStartSweep(StartSweep::Request& req, StartSweep::Response& res);
+  bool onStartWholeAngle(StartWholeAngle::Request& req, StartWholeAngle::Response& res);
   /// Simulates the whole record now (InputError / AnalysisError from the core pass through).
   /// start.r = 0: from the drive's stationary state; else from these orbit elements.
   void startFreeDecay(double duration_s, int seed, const OrbitElements& start = OrbitElements());
@@ -55,8 +59,8 @@ class SimulatorNode {
   SimulatorNodeOptions options_;
   ResonatorPreset preset_;  ///< as loaded, noise scaled by options_.noise_scale
 
-  ros::Publisher raw_pub_, slow_pub_, slow_truth_pub_, sweep_pub_, truth_pub_;
-  ros::ServiceServer start_free_decay_srv_, start_sweep_srv_;
+  ros::Publisher raw_pub_, slow_pub_, slow_truth_pub_, sweep_pub_, truth_pub_, whole_angle_pub_;
+  ros::ServiceServer start_free_decay_srv_, start_sweep_srv_, start_whole_angle_srv_;
   ros::WallTimer timer_, autostart_timer_;
 
   Running running_ = Running::kNone;

@@ -9,6 +9,22 @@
 #include "cvg_bench/core/simulate/measurement_noise.h"
 
 namespace cvg_bench {
+namespace {
+
+/// The default walk: 1.5 periods of theta over the run, and at least 4x the largest drift the
+/// resonator has at (r0, k0) over theta: a slower walk lets the pattern lock where the drift
+/// cancels it (the MEMS ring drifts ~35 deg/s, more than 1.5 periods over its 4 s default run).
+double defaultWalk(const ResonatorModel& model, const ResonatorPreset& preset,
+                   const WholeAngleOptions& o, double duration) {
+  double peak = 0.0;
+  for (int i = 0; i < 36; ++i) {
+    const OrbitElements x{o.r0, o.k0, -M_PI / 4 + (M_PI / 2) * i / 36.0, 0.0};
+    peak = std::max(peak, std::abs(orbitRatesOfModel(model, preset.parameters, x, 0.0).theta_dot));
+  }
+  return std::max(1.5 * (M_PI / 2.0) / duration, 4.0 * peak);
+}
+
+}  // namespace
 
 namespace {
 
@@ -34,7 +50,7 @@ SlowRecord simulateWholeAngle(const ResonatorPreset& preset, const WholeAngleOpt
   const double rate = o.sample_rate_hz > 0.0 ? o.sample_rate_hz : preset.decay_sample_rate_hz;
   requirePositive(duration, "whole-angle duration");
   requirePositive(rate, "whole-angle sample rate");
-  const double walk = o.walk_rad_s != 0.0 ? o.walk_rad_s : 1.5 * (M_PI / 2.0) / duration;
+  const double walk = o.walk_rad_s != 0.0 ? o.walk_rad_s : defaultWalk(model, preset, o, duration);
   requireFinite(walk, "whole-angle walk");
   const long n = static_cast<long>(std::floor(duration * rate)) + 1;
   if (n < 10 || n > 20000000)

@@ -19,11 +19,12 @@
 namespace cvg_bench {
 
 struct WholeAngleOptions {
-  double r0 = 0.5;             ///< amplitude held [record units], > 0
-  double k0 = 0.0;             ///< quadrature held, |k0| < r0
-  double loop_rate_1_s = 0.0;  ///< loop gain g [1/s]; 0 = ideal loops (r and k held exactly)
-  double walk_rad_s = 0.0;  ///< base-rotation walk of theta [rad/s]; 0 = 1.5 x (pi/2) over the run
-  double duration_s = 0.0;  ///< 0 = the preset's free-decay duration x 20
+  double r0 = 0.5;              ///< amplitude held [record units], > 0
+  double k0 = 0.0;              ///< quadrature held, |k0| < r0
+  double loop_rate_1_s = 0.0;   ///< loop gain g [1/s]; 0 = ideal loops (r and k held exactly)
+  double walk_rad_s = 0.0;      ///< base-rotation walk of theta [rad/s]; 0 = 1.5 x (pi/2) over the
+                                ///< run and at least 4x the resonator's largest drift (no lock)
+  double duration_s = 0.0;      ///< 0 = the preset's free-decay duration x 20
   double sample_rate_hz = 0.0;  ///< 0 = the preset's free-decay rate
   double noise_std = -1.0;      ///< on q; < 0 = the preset's
   std::uint64_t seed = 1;
