@@ -79,7 +79,8 @@ IdentifierNode::IdentifierNode(const ros::NodeHandle& nh, const ros::NodeHandle&
   truth_sub_ = nh_.subscribe("truth", 10, &IdentifierNode::onTruth, this);
   loss_sub_ = nh_.subscribe("input_loss", 100, &IdentifierNode::onInputLoss, this);
   // A whole-angle run arrives as a burst of states (thousands a second): its own deep queue, and
-  // sequence gaps counted (WholeAngleRunBuffer::lost) rather than a silently shorter run.
+  // sequence gaps counted (WholeAngleRunBuffer::lost: the subscriber queue's overflow or the
+  // network) rather than a silently shorter run.
   whole_angle_sub_ = nh_.subscribe("whole_angle", std::max(options_.queue_size, 100000),
                                    &IdentifierNode::onWholeAngle, this);
   drift_measured_pub_ = nh_.advertise<DriftMeasured>("drift_measured", 2, /*latch=*/true);
@@ -881,31 +882,43 @@ bool IdentifierNode::onMeasureDrift(MeasureDrift::Request& req, MeasureDrift::Re
       throw InputError("bins: need 4..3600 theta bins (0 = 24)");
     SlowRecord run;
     UncertainParameters params;
-    uint64_t lost = 0;
+    uint64_t lost = 0, dropped = 0;
+    std::string frame_id;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!have_estimate_) throw InputError("no estimate yet: identify a free decay first");
+      // As `cvg_ident drift`: a rank-deficient estimate predicts nothing (#25).
+      if (estimate_.rank < estimate_.n_params)
+        throw InputError("the latest estimate is rank-deficient (rank " +
+                         std::to_string(estimate_.rank) + " of " +
+                         std::to_string(estimate_.n_params) +
+                         "): it predicts no drift; identify a longer record or several decays");
       if (whole_angle_.size() == 0)
         throw InputError("no whole-angle run received on " + whole_angle_sub_.getTopic());
       run = whole_angle_.record();
       lost = whole_angle_.lost();
+      dropped = whole_angle_.dropped();
       params = uncertainParameters(estimate_);
+      frame_id = options_.frame_id;
     }
     // Measured outside the lock: the data callbacks go on meanwhile.
     const DriftComparison c = measureDrift(
         run, req.walk_rad_s, params, req.bins ? static_cast<int>(req.bins) : 24, params.confidence);
     res.comparison = driftComparisonToMsg(c, params.confidence, ros::Time::now());
-    res.comparison.header.frame_id = options_.frame_id;
+    res.comparison.header.frame_id = frame_id;
     drift_measured_pub_.publish(res.comparison);
     res.success = true;
-    res.message = c.summary + " (" + std::to_string(run.size()) + " states of the run" +
-                  (lost ? ", " + std::to_string(lost) + " lost in transport" : "") + ")";
+    res.message =
+        c.summary + " (" + std::to_string(run.size()) + " states of the run" +
+        (lost ? ", " + std::to_string(lost) + " lost before the buffer" : "") +
+        (dropped ? ", " + std::to_string(dropped) + " dropped (out of order or buffer full)" : "") +
+        ")";
   } catch (const std::exception& e) {
     res.success = false;
     res.message = e.what();
     std::lock_guard<std::mutex> lock(mutex_);
     if (whole_angle_.lost())
-      res.message += " (" + std::to_string(whole_angle_.lost()) + " states lost in transport)";
+      res.message += " (" + std::to_string(whole_angle_.lost()) + " states lost before the buffer)";
   }
   return true;
 }
@@ -913,6 +926,7 @@ bool IdentifierNode::onMeasureDrift(MeasureDrift::Request& req, MeasureDrift::Re
 bool IdentifierNode::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& res) {
   std::lock_guard<std::mutex> lock(mutex_);
   clearData("reset requested");
+  whole_angle_.clear();
   have_estimate_ = false;
   estimate_ = Estimate();
   res.success = true;
@@ -939,7 +953,7 @@ bool IdentifierNode::onExplain(Explain::Request& req, Explain::Response& res) {
                                                                : explainForced(in.sweep, eo);
     std::string selected;
     for (const auto& s : ex.selection.selected) selected += (selected.empty() ? "" : "+") + s;
-    res.success = true;
+    res.success = ex.determined;  // a model the buffer does not determine is no answer (#25)
     res.message = ex.cause + " [selected: " + (selected.empty() ? "none" : selected) +
                   (ex.unexplained ? "; structure remains unexplained" : "") + "]";
     res.report_json = report::explanationToJson(ex).dump();  // as `cvg_ident explain` writes

@@ -68,8 +68,15 @@ void printSummary(const Explanation& x) {
               << s.wald.p_value << ", sigma ratio " << s.sigma_ratio << ")\n";
   std::cout << "selection: " << x.selection.criterion_description << "\n";
   if (!x.selection.runner_up.model.empty())
+    // The same words as the verdict's: a negative delta is a better criterion the hold-out did not
+    // confirm (it printed "-25 worse").
     std::cout << "runner-up: " << x.selection.runner_up.model << ", criterion "
-              << x.selection.runner_up_delta << " worse than " << x.selection.chosen.model << "\n";
+              << x.selection.runner_up_delta
+              << (!std::isfinite(x.selection.runner_up_delta) ? " (not comparable) against "
+                  : x.selection.runner_up_delta >= 0
+                      ? " worse than "
+                      : " better (not confirmed by the hold-out) than ")
+              << x.selection.chosen.model << "\n";
   std::cout << "baseline residual signature: " << x.baseline_signature.describe(0.01) << "\n";
   std::cout << "selected: " << (x.selection.selected.empty() ? "none" : "");
   for (size_t i = 0; i < x.selection.selected.size(); ++i)

@@ -28,7 +28,14 @@ TEST(WholeAngleRunBuffer, KeepsOneRunInOrderAndCountsWhatIsMissing) {
   EXPECT_TRUE(b.add(e2, ros::Time(200.1), 20, kQ, 0.0));
   EXPECT_EQ(b.size(), 1u);
   EXPECT_EQ(b.lost(), 0u);
+  EXPECT_EQ(b.dropped(), 0u);  // counts are per run
   EXPECT_EQ(b.runs(), 2u);
+  // A sequence number that goes back (another publisher, a wrap) is no loss.
+  EXPECT_TRUE(b.add(e2, ros::Time(200.2), 3, kQ, 0.0));
+  EXPECT_TRUE(b.add(e2, ros::Time(200.3), 4, kQ, 0.0));
+  EXPECT_EQ(b.lost(), 0u);
+  b.clear();
+  EXPECT_EQ(b.size(), 0u);
 }
 
 TEST(WholeAngleRunBuffer, AFullBufferDropsInsteadOfGrowing) {

@@ -1,8 +1,10 @@
 // The whole-angle run an identifier measures drift from (issue #26): slow states received on
 // `whole_angle`, kept apart from the identification buffer so the free-decay estimate stays. A
 // new phase epoch starts a new run (the buffer is cleared); a state stamped at or before the
-// previous one is dropped and counted, never inserted out of order; gaps in the publisher's
-// sequence numbers count the states lost in transport (said with the measurement).
+// previous one, or one over the limit, is dropped and counted, never inserted out of order; gaps in
+// the publisher's sequence numbers count the states lost before the buffer (the subscriber queue's
+// overflow or the network; said with the measurement). A sequence number that goes back (a new
+// publisher, a wrap) restarts the count without a loss. Counts are per run.
 #pragma once
 
 #include <ros/time.h>
@@ -27,6 +29,8 @@ class WholeAngleRunBuffer {
   size_t size() const { return q_.size(); }
   uint64_t dropped() const { return dropped_; }
   uint64_t runs() const { return runs_; }
+  /// Forgets the run (the identifier's reset).
+  void clear();
   /// States of the current run missing between received ones (sequence-number gaps).
   uint64_t lost() const { return lost_; }
 

@@ -578,10 +578,11 @@ std::string recordName(const SlowRecord& r, size_t k) {
   return r.source.empty() ? "record " + std::to_string(k + 1) : r.source;
 }
 
-/// Stacked free decays must be of one resonator (their natural frequencies agree to 1e-9, or are
-/// unknown in all)
-/// and each counted once: a record given twice would narrow every interval as if it were new data.
-void requireOneResonator(const std::vector<const SlowRecord*>& records) {
+/// Stacked free decays must be of one resonator and each counted once: a record given twice would
+/// narrow every interval as if it were new data. Without a given omega their natural frequencies
+/// must agree within 100 ppm (a resonator's drift with temperature; the first record's is used),
+/// or be unknown in all; a given omega (--omega) is the common one.
+void requireOneResonator(const std::vector<const SlowRecord*>& records, double option_omega) {
   for (size_t k = 1; k < records.size(); ++k) {
     const SlowRecord& r = *records[k];
     for (size_t j = 0; j < k; ++j)
@@ -589,12 +590,13 @@ void requireOneResonator(const std::vector<const SlowRecord*>& records) {
         throw InputError(recordName(r, k) +
                          ": given twice; a record counted twice would narrow every interval as if "
                          "it were new data");
+    if (option_omega > 0.0) continue;
     const double w0 = records.front()->omega_rad_s, w = r.omega_rad_s;
-    if (std::fabs(w - w0) > 1e-9 * std::max(std::fabs(w0), std::fabs(w)))
+    if (!std::isfinite(w) || !(std::fabs(w - w0) <= 1e-4 * std::max(std::fabs(w0), std::fabs(w))))
       throw InputError(recordName(r, k) + ": omega " + fmt(w) + " rad/s differs from " +
                        recordName(*records.front(), 0) + "'s " + fmt(w0) +
-                       " rad/s: only records of one resonator are stacked (raw records each get "
-                       "their own estimated frequency: give their common --omega)");
+                       " rad/s by more than 100 ppm: stacked records must be of one resonator; "
+                       "give their common --omega (raw records each get their own estimate)");
   }
 }
 
@@ -612,7 +614,7 @@ Estimate identifyFreeDecayRecords(const std::vector<const SlowRecord*>& records,
   info.resonator = &model;
   info.omega_rad_s = resolveOmega(options.omega_rad_s, records[0]->omega_rad_s, false, "");
   info.noise_correlation = noiseCorrelationFromMetadata(records[0]->metadata);
-  requireOneResonator(records);
+  requireOneResonator(records, options.omega_rad_s);
   std::vector<bool> simpson(records.size());
   for (size_t r = 0; r < records.size(); ++r) {
     const SlowRecord& rec = *records[r];

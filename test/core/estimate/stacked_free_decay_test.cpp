@@ -52,13 +52,19 @@ TEST(StackedFreeDecay, EachRecordKeepsItsOwnEquations) {
 TEST(StackedFreeDecay, AnotherFrequencyATwiceGivenRecordAndCeresAreRefused) {
   const PipelineOptions o = linearLs();
   SlowRecord b = decayAt(0.6, 2);
-  b.omega_rad_s = 30001.0;
+  b.omega_rad_s = 30010.0;  // 333 ppm: another resonator
   EXPECT_THROW(identify({decayAt(0.0, 1), b}, o), InputError);
   try {
     identify({decayAt(0.0, 1), b}, o);
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("--omega"), std::string::npos) << e.what();
   }
+  PipelineOptions common = o;  // a given omega is the common one: then they stack
+  common.identification.omega_rad_s = 30000.0;
+  EXPECT_NO_THROW(identify({decayAt(0.0, 1), b}, common));
+  SlowRecord near = decayAt(0.6, 2);
+  near.omega_rad_s = 30000.0 * (1.0 + 2e-5);  // 20 ppm: a temperature drift, still one resonator
+  EXPECT_NO_THROW(identify({decayAt(0.0, 1), near}, o));
   const SlowRecord a = decayAt(0.0, 1);
   EXPECT_THROW(identify({a, a}, o), InputError);  // one source counted twice
   PipelineOptions ceres = o;

@@ -71,8 +71,9 @@ struct IdentificationOptions {
 Estimate identifyFreeDecay(const SlowRecord& record, const IdentificationOptions& options);
 /// Several records stacked into one regression (e.g. runs at different pattern angles,
 /// docs/paper.md item 11); each record keeps its own time origin, integration rule and lag
-/// structure, and no equation joins two records. InputError also when the records' natural
-/// frequencies differ (relative 1e-9; unknown in all is allowed) or one record is given twice.
+/// structure, and no equation joins two records. InputError also when one record is given twice,
+/// or, without options.omega_rad_s, when the records' natural frequencies differ by more than
+/// 100 ppm (unknown in all is allowed).
 Estimate identifyFreeDecay(const std::vector<SlowRecord>& records,
                            const IdentificationOptions& options);
 
