@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
+
 namespace cvg_bench {
 namespace report {
 namespace {
@@ -43,20 +45,20 @@ nlohmann::json ringdownFitToJson(const RingdownFit& fit, const RingdownSegment& 
   j["rank"] = fit.rank;
   j["unidentifiable"] = nlohmann::json::array();
   j["sigma"] = num(fit.sigma);
-  j["rms_residual_db"] = num(fit.rms_log * 20.0 / std::log(10.0));
+  j["rms_residual_db"] = num(fit.rms_log * kDbPerNeper);
   j["residual_lag1_correlation"] = num(fit.rho1);
   j["confidence"] = confidence;
-  j["segment"] = {{"t_start", seg.t_start_s},
-                  {"t_end", seg.t_end_s},
-                  {"why", seg.why},
-                  {"has_plateau", seg.has_plateau},
-                  {"drive_off_s", seg.drive_off_s},
-                  {"has_floor", seg.has_floor},
-                  {"floor_db", seg.has_floor ? num(seg.floor_log_amplitude * 20.0 / std::log(10.0))
-                                             : nlohmann::json()},
-                  {"n_used", seg.n_used},
-                  {"n_dropouts", seg.n_dropouts_in_span},
-                  {"decay_db", num(seg.decay_db)}};
+  j["segment"] = {
+      {"t_start", seg.t_start_s},
+      {"t_end", seg.t_end_s},
+      {"why", seg.why},
+      {"has_plateau", seg.has_plateau},
+      {"drive_off_s", seg.drive_off_s},
+      {"has_floor", seg.has_floor},
+      {"floor_db", seg.has_floor ? num(seg.floor_log_amplitude * kDbPerNeper) : nlohmann::json()},
+      {"n_used", seg.n_used},
+      {"n_dropouts", seg.n_dropouts_in_span},
+      {"decay_db", num(seg.decay_db)}};
   j["error_model"] = {{"name", fit.error_model}, {"why", fit.error_model_why}};
   nlohmann::json params = nlohmann::json::object(), derived = nlohmann::json::object(),
                  dci = nlohmann::json::object(), crb = nlohmann::json::object();

@@ -13,6 +13,7 @@
 #include "bag_input.h"
 #include "cli_args.h"
 #include "cvg_bench/core/diagnose/ringdown_causes.h"
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
 #include "cvg_bench/core/estimate/ringdown_span_spread.h"
 #include "cvg_bench/core/io/ringdown_record.h"
 #include "cvg_bench/core/model/errors.h"
@@ -25,8 +26,6 @@
 namespace cvg_bench {
 namespace tools {
 namespace {
-
-constexpr double kDbPerNeper = 20.0 / 2.302585092994046;
 
 const char* kIdentifyHelp =
     "usage: cvg_ident identify INPUT --mode ringdown --model linear|TERMS [--frequency HZ]\n"

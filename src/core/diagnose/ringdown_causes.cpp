@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
 #include "cvg_bench/core/estimate/ringdown_intervals.h"
 #include "cvg_bench/core/estimate/ringdown_models.h"
 #include "cvg_bench/core/estimate/ringdown_span_spread.h"
@@ -298,9 +299,8 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     if (f.fitted.size() == x.baseline.fitted.size()) {
       for (size_t i = 0; i < f.fitted.size(); ++i)
         s.effect_db = std::max(s.effect_db, std::fabs(f.fitted[i] - x.baseline.fitted[i]));
-      s.effect_db *= 20.0 / std::log(10.0);
-      s.effect_over_rms =
-          s.effect_db / std::max(x.baseline.rms_log * 20.0 / std::log(10.0), 1e-300);
+      s.effect_db *= kDbPerNeper;
+      s.effect_over_rms = s.effect_db / std::max(x.baseline.rms_log * kDbPerNeper, 1e-300);
     }
     x.information_criterion[s.added] = s.information_criterion;
     if (isAmplitudeLaw(s.added)) {
@@ -519,8 +519,8 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
   };
   if (x.segment.has_floor) {
     x.causes.push_back("noise_floor");
-    cs << "Noise floor at " << fmt(x.segment.floor_log_amplitude * 20.0 / std::log(10.0))
-       << " dB from " << fmt(x.segment.floor_start_s) << " s: the fit stops "
+    cs << "Noise floor at " << fmt(x.segment.floor_log_amplitude * kDbPerNeper) << " dB from "
+       << fmt(x.segment.floor_start_s) << " s: the fit stops "
        << options.segmentation.floor_margin_db << " dB above it. ";
   }
   if (x.segment.n_dropouts_in_span > 0) {

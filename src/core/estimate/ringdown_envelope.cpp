@@ -18,7 +18,7 @@ RingdownEnvelope ringdownEnvelope(const RingdownRecord& record, double frequency
     env.t_s = record.t_s;
     env.log_amplitude.resize(record.size());
     env.from_db = record.kind == RingdownValueKind::kPowerDb;
-    const double db_to_ln = std::log(10.0) / 20.0;
+    const double db_to_ln = 1.0 / kDbPerNeper;
     for (size_t i = 0; i < record.size(); ++i) {
       const double v = record.value[i];
       if (env.from_db)

@@ -7,6 +7,8 @@
 #include <limits>
 #include <sstream>
 
+#include "cvg_bench/core/estimate/numeric_least_squares.h"
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
 #include "cvg_bench/core/estimate/ringdown_intervals.h"
 #include "cvg_bench/core/estimate/ringdown_models.h"
 #include "cvg_bench/core/model/sample_median.h"
@@ -14,7 +16,6 @@
 namespace cvg_bench {
 namespace {
 
-constexpr double kDbPerNeper = 20.0 / 2.302585092994046;
 constexpr int kMaxOrder = 4;
 
 double median(const std::vector<double>& v) {
@@ -52,50 +53,6 @@ double correlationMisfit(int order, double t_samples, const std::vector<double>&
     s += e * e;
   }
   return s;
-}
-
-/// Levenberg-Marquardt on a residual function (steps by QR of [J; sqrt(lambda) D], Jacobian by
-/// central differences). Returns false when the start gives no finite residuals.
-bool minimize(const std::function<bool(const Eigen::VectorXd&, Eigen::VectorXd&)>& res,
-              Eigen::VectorXd& p, double& sse) {
-  Eigen::VectorXd r;
-  if (!res(p, r)) return false;
-  sse = r.squaredNorm();
-  double lambda = 1e-3;
-  Eigen::VectorXd rp, rm;
-  for (int it = 0; it < 80; ++it) {
-    Eigen::MatrixXd J(r.size(), p.size());
-    for (int k = 0; k < p.size(); ++k) {
-      const double h = 1e-6 * (1.0 + std::fabs(p(k)));
-      Eigen::VectorXd pp = p, pm = p;
-      pp(k) += h, pm(k) -= h;
-      if (!res(pp, rp) || !res(pm, rm)) return true;
-      J.col(k) = -(rp - rm) / (2.0 * h);
-    }
-    const Eigen::VectorXd dscale = J.colwise().norm().cwiseMax(1e-12);
-    bool improved = false;
-    for (int inner = 0; inner < 12 && !improved; ++inner) {
-      Eigen::MatrixXd A(J.rows() + p.size(), p.size());
-      Eigen::VectorXd b = Eigen::VectorXd::Zero(J.rows() + p.size());
-      A.topRows(J.rows()) = J;
-      A.bottomRows(p.size()) = (std::sqrt(lambda) * dscale).asDiagonal();
-      b.head(J.rows()) = r;
-      const Eigen::VectorXd step = A.colPivHouseholderQr().solve(b);
-      const Eigen::VectorXd pn = p + step;
-      Eigen::VectorXd rn;
-      if (res(pn, rn) && rn.squaredNorm() < sse) {
-        const double rel = (sse - rn.squaredNorm()) / std::max(sse, 1e-300);
-        p = pn, r = rn, sse = rn.squaredNorm();
-        lambda = std::max(lambda / 5.0, 1e-12);
-        improved = true;
-        if (rel < 1e-10 || step.norm() < 1e-12 * (1.0 + p.norm())) return true;
-      } else {
-        lambda *= 8.0;
-      }
-    }
-    if (!improved) return true;
-  }
-  return true;
 }
 
 }  // namespace
@@ -321,7 +278,7 @@ RingdownFilteredFit fitRingdownThroughFilter(const RingdownEnvelope& env,
     q.head(np) = law_fit.p;
     q(np) = off0 + shift * filter.order * tf;
     double sse = 0.0;
-    if (!minimize(res, q, sse)) continue;
+    if (!minimizeSumOfSquares(res, q, sse, 80)) continue;
     if (sse < best) best = sse, out.p = q;
   }
   if (!std::isfinite(best)) return out;

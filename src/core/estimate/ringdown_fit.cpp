@@ -7,6 +7,8 @@
 #include <limits>
 #include <sstream>
 
+#include "cvg_bench/core/estimate/numeric_least_squares.h"
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
 #include "cvg_bench/core/estimate/ringdown_intervals.h"
 #include "cvg_bench/core/estimate/ringdown_models.h"
 #include "cvg_bench/core/estimate/student_t.h"
@@ -16,7 +18,6 @@
 namespace cvg_bench {
 namespace {
 
-constexpr double kDbPerNeper = 20.0 / 2.302585092994046;
 const double kInf = std::numeric_limits<double>::infinity();
 
 double median(const std::vector<double>& v) {
@@ -52,46 +53,6 @@ bool jacobian(const std::string& model, const Eigen::VectorXd& p, const Data& d,
     if (!residuals(model, pp, d, floor_rel, rp) || !residuals(model, pm, d, floor_rel, rm))
       return false;
     J.col(k) = -(rp - rm) / (2.0 * h);  // d(sqrt(w) f)/dp
-  }
-  return true;
-}
-
-/// Levenberg-Marquardt on the weighted residuals, steps by QR of [J; sqrt(lambda) D].
-bool levenbergMarquardt(const std::string& model, Eigen::VectorXd& p, const Data& d,
-                        double floor_rel, double& sse) {
-  Eigen::VectorXd r;
-  if (!residuals(model, p, d, floor_rel, r)) return false;
-  sse = r.squaredNorm();
-  double lambda = 1e-3;
-  Eigen::MatrixXd J;
-  for (int it = 0; it < 100; ++it) {
-    if (!jacobian(model, p, d, floor_rel, J)) return false;
-    const Eigen::VectorXd dscale = J.colwise().norm().cwiseMax(1e-12);
-    bool improved = false;
-    for (int inner = 0; inner < 12 && !improved; ++inner) {
-      Eigen::MatrixXd A(J.rows() + p.size(), p.size());
-      Eigen::VectorXd b(J.rows() + p.size());
-      A.topRows(J.rows()) = J;
-      A.bottomRows(p.size()) = (std::sqrt(lambda) * dscale).asDiagonal();
-      b.head(J.rows()) = r;
-      b.tail(p.size()).setZero();
-      const Eigen::VectorXd step = A.colPivHouseholderQr().solve(b);
-      const Eigen::VectorXd pn = p + step;
-      Eigen::VectorXd rn;
-      if (residuals(model, pn, d, floor_rel, rn) && rn.squaredNorm() < sse) {
-        const double rel = (sse - rn.squaredNorm()) / std::max(sse, 1e-300);
-        p = pn;
-        r = rn;
-        sse = rn.squaredNorm();
-        lambda = std::max(lambda / 5.0, 1e-12);
-        improved = true;
-        // A relative decrease of 1e-10 moves the estimate by ~1e-5 sqrt(n) of its standard error.
-        if (rel < 1e-10 || step.norm() < 1e-12 * (1.0 + p.norm())) return true;
-      } else {
-        lambda *= 8.0;
-      }
-    }
-    if (!improved) return true;  // no decrease at any damping: a minimum
   }
   return true;
 }
@@ -459,7 +420,14 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
   for (auto p : st) {
     double sse = kInf;
     if (p.size() != static_cast<int>(fit.names.size())) continue;
-    if (!levenbergMarquardt(model, p, d, fit.floor_rel, sse)) continue;
+    const ResidualFunction weighted = [&](const Eigen::VectorXd& q, Eigen::VectorXd& r) {
+      return residuals(model, q, d, fit.floor_rel, r);
+    };
+    // A fit whose Jacobian cannot be evaluated at its answer (a law at the edge of its domain)
+    // has no covariance: that start is dropped.
+    Eigen::MatrixXd J_at;
+    if (!minimizeSumOfSquares(weighted, p, sse) || !jacobian(model, p, d, fit.floor_rel, J_at))
+      continue;
     if (sse < best) best = sse, fit.p = p;
   }
   if (!std::isfinite(best))

@@ -5,12 +5,11 @@
 #include <limits>
 #include <sstream>
 
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
 #include "cvg_bench/core/estimate/ringdown_segmentation.h"
 
 namespace cvg_bench {
 namespace {
-
-constexpr double kDbPerNeper = 20.0 / 2.302585092994046;  // 20 / ln 10
 
 /// Median of the finite values of y[a, b) (clipped to the record); NaN when none.
 double medianOf(const std::vector<double>& y, long a, long b) {

@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
 #include "cvg_bench/core/estimate/ringdown_models.h"
 #include "cvg_bench/core/estimate/ringdown_record_window.h"
 #include "cvg_bench/core/estimate/ringdown_straight_span.h"
@@ -15,7 +16,6 @@
 namespace cvg_bench {
 namespace {
 
-constexpr double kDbPerNeper = 20.0 / 2.302585092994046;  // 20 / ln 10
 /// A floor: the fitted floor lies this far above the decay's straight continuation at the end
 /// [dB], and the floor model beats the straight line by this evidence (n ln(SSE_0 / SSE_1)).
 constexpr double kFloorExcessDb = 3.0;

@@ -5,12 +5,11 @@
 #include <cmath>
 #include <limits>
 
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
 #include "cvg_bench/core/estimate/ringdown_segmentation.h"
 
 namespace cvg_bench {
 namespace {
-
-constexpr double kDbPerNeper = 20.0 / 2.302585092994046;  // 20 / ln 10
 
 double medianOf(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();

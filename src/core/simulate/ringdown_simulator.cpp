@@ -5,6 +5,7 @@
 #include <random>
 #include <sstream>
 
+#include "cvg_bench/core/estimate/ringdown_envelope.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
@@ -50,7 +51,7 @@ RingdownRecord simulateRingdown(const RingdownSimulationOptions& o) {
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> N01(0.0, 1.0);
   const double rho = o.noise_correlation, innov = std::sqrt(1.0 - rho * rho);
-  const double sd_m = o.noise_db / (20.0 / std::log(10.0));
+  const double sd_m = o.noise_db / (kDbPerNeper);
   double em = sd_m * N01(rng);
   std::complex<double> na(floor_amp / std::sqrt(2.0) * N01(rng),
                           floor_amp / std::sqrt(2.0) * N01(rng));
