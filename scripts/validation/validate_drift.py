@@ -29,7 +29,7 @@ pooled, the added-term cases (xi_diff, xi_diff + gamma_nl) as well; a case ident
 term the resonator has is expected to fail the pooled check where that term moves theta'.
 
 usage: validate_drift.py [--out DIR] [--markdown FILE] [--seed N] [--decays N] [--pool N] [--pool-only]
-                         [--pool-cases shipped|all]
+                         [--pool-cases shipped|all] [--k0 FRACTION_OF_R0]
 """
 import json
 import math
@@ -62,6 +62,12 @@ def header(path):
             k, _, v = line[1:].partition(":")
             h[k.strip()] = v.strip()
     return h
+
+
+# --k0 F: the quadrature the whole-angle loops hold, as a fraction of r0 (default 0). At k = 0 the
+# cubic terms (xi, xi_k, kappa, xi_diff) do not move theta' (they act through k), so a left-out
+# xi_diff shows only through the bias it leaves in the other parameters; at k0 != 0 directly.
+K0_FRACTION = 0.0
 
 
 def drift_scale(truth, r0):
@@ -118,7 +124,8 @@ def one(preset, label, effects, terms, work, seed, decays):
     with open(tj, "w") as f:
         json.dump({"omega": float(h["omega"]), "parameters": truth}, f)
     gj = os.path.join(work, tag + "_grid.json")
-    rc, _, err = run(["drift", "--params", tj, "--r", "0.5", "--k", "0", "--theta-grid", "36", "--json", gj])
+    k0 = K0_FRACTION * 0.5
+    rc, _, err = run(["drift", "--params", tj, "--r", "0.5", "--k", repr(k0), "--theta-grid", "36", "--json", gj])
     if rc != 0:
         return {"error": "drift grid: " + err.strip()[-200:]}
     with open(gj) as f:
@@ -126,7 +133,8 @@ def one(preset, label, effects, terms, work, seed, decays):
     walk = max(4.0 * peak, 1e-6)
     duration = 1.5 * (math.pi / 2) / walk
     rc, _, err = run(["simulate", "--preset", preset, "--mode", "whole_angle", "--seed", str(seed + 1),
-                      "--walk", repr(walk), "--duration", repr(duration), "--out", wa] + fx)
+                      "--walk", repr(walk), "--duration", repr(duration), "--quadrature", repr(k0),
+                      "--out", wa] + fx)
     if rc != 0:
         return {"error": "simulate whole_angle: " + err.strip()[-200:]}
     rc, _, err = run(["drift", "--params", est, "--measured", wa, "--json", out, "--png", png])
@@ -207,6 +215,8 @@ def pooled_case(work, seed, decays, pool, preset, label, effects, terms):
 
 
 def main():
+    global K0_FRACTION
+    K0_FRACTION = arg("--k0", 0.0)
     seed = arg("--seed", 4100)
     pool = arg("--pool", 10)
     decays = arg("--decays", 8)
