@@ -5,7 +5,7 @@
 #include <random>
 #include <sstream>
 
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
+#include "cvg_bench/core/io/ringdown_record.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {

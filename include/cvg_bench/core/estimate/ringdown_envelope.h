@@ -11,9 +11,6 @@
 
 namespace cvg_bench {
 
-/// dB of power per neper of amplitude, 20 / ln 10: a level P_dB = kDbPerNeper ln A (+ a constant).
-inline constexpr double kDbPerNeper = 20.0 / 2.302585092994046;
-
 struct RingdownEnvelope {
   std::vector<double> t_s;
   std::vector<double> log_amplitude;  ///< ln A [ln of the file's unit]; NaN where not finite

@@ -11,6 +11,9 @@
 
 namespace cvg_bench {
 
+/// dB of power per neper of amplitude, 20 / ln 10: a level P_dB = kDbPerNeper ln A (+ a constant).
+inline constexpr double kDbPerNeper = 20.0 / 2.302585092994046;
+
 /// What the value column of a ring-down holds.
 enum class RingdownValueKind {
   kAmplitude,    ///< linear amplitude, any unit (> 0; <= 0 or non-finite = drop-out)
