@@ -11,6 +11,7 @@
 
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/collinearity.h"
+#include "cvg_bench/core/estimate/dense_solver_options.h"
 #include "cvg_bench/core/estimate/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/fitted_residual_ar1.h"
 #include "cvg_bench/core/estimate/hac_covariance.h"
@@ -109,18 +110,12 @@ struct FittedProblem {
 /// CeresOptions::likelihood_tolerance to Ceres's relative function tolerance.
 void solveOrThrow(ceres::Problem* problem, const CeresOptions& options, long n_residuals,
                   ceres::Solver::Summary* summary) {
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = options.max_iterations;
-  so.function_tolerance = options.function_tolerance;
+  DenseSolverStop stop{options.max_iterations, options.function_tolerance,
+                       options.parameter_tolerance, options.gradient_tolerance};
   if (n_residuals >= 4 * options.likelihood_tolerance_min_samples)
-    so.function_tolerance = std::max(
-        so.function_tolerance, options.likelihood_tolerance / static_cast<double>(n_residuals));
-  so.parameter_tolerance = options.parameter_tolerance;
-  so.gradient_tolerance = options.gradient_tolerance;
-  so.logging_type = ceres::SILENT;
-  so.minimizer_progress_to_stdout = false;
-  ceres::Solve(so, problem, summary);
+    stop.function_tolerance = std::max(
+        stop.function_tolerance, options.likelihood_tolerance / static_cast<double>(n_residuals));
+  ceres::Solve(denseSolverOptions(stop), problem, summary);
   if (!summary->IsSolutionUsable())
     throw AnalysisError("Ceres refinement found no usable solution (" +
                         std::string(ceres::TerminationTypeToString(summary->termination_type)) +

@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "cvg_bench/core/estimate/dense_solver_options.h"
+
 namespace cvg_bench {
 namespace {
 
@@ -61,15 +63,8 @@ bool minimizeSumOfSquares(const ResidualFunction& residuals, Eigen::VectorXd& p,
   const int k = static_cast<int>(p.size());
   Eigen::VectorXd best_p = p;
   double best_sse = r.squaredNorm();
-  ceres::Solver::Options o;
-  o.linear_solver_type = ceres::DENSE_QR;
-  o.max_num_iterations = max_iterations;
   // A relative decrease of 1e-10 moves an estimate by ~1e-5 sqrt(n) of its standard error.
-  o.function_tolerance = 1e-10;
-  o.parameter_tolerance = 1e-12;
-  o.gradient_tolerance = 1e-14;
-  o.logging_type = ceres::SILENT;
-  o.num_threads = 1;
+  const ceres::Solver::Options o = denseSolverOptions({max_iterations, 1e-10, 1e-12, 1e-14});
   // Ceres stops with FAILURE where a Jacobian cannot be evaluated (next to a refused region) and
   // hands back its start: solved again from the lowest point seen while that still improves it,
   // as a Levenberg-Marquardt loop would go on from there.

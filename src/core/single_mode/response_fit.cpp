@@ -10,6 +10,7 @@
 #include <limits>
 #include <numeric>
 
+#include "cvg_bench/core/estimate/dense_solver_options.h"
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 
@@ -115,12 +116,8 @@ double rssWithFreeDriveScales(const ResponseData& d, const Layout& L, const Resp
   cost->SetNumResiduals(static_cast<int>(2 * d.size()));
   ceres::Problem problem;
   problem.AddResidualBlock(cost, nullptr, x.data(), s.data());
-  ceres::Solver::Options o;
-  o.linear_solver_type = ceres::DENSE_QR;
-  o.max_num_iterations = 200;
-  o.logging_type = ceres::SILENT;
   ceres::Solver::Summary sum;
-  ceres::Solve(o, &problem, &sum);
+  ceres::Solve(denseSolverOptions({200}), &problem, &sum);
   ResponseData ds = d;
   ds.resonant_drive_factor.assign(ds.size(), 1.0);
   for (size_t i = 0; i < ds.size(); ++i)
@@ -154,16 +151,8 @@ ResponseParams refine(const ResponseData& d, const Layout& L, const ResponsePara
   cost->SetNumResiduals(static_cast<int>(2 * d.size()));
   ceres::Problem problem;
   problem.AddResidualBlock(cost, nullptr, x.data());
-  ceres::Solver::Options o;
-  o.linear_solver_type = ceres::DENSE_QR;
-  o.max_num_iterations = max_iterations;
-  o.function_tolerance = 1e-12;
-  o.parameter_tolerance = 1e-12;
-  o.gradient_tolerance = 1e-14;
-  o.logging_type = ceres::SILENT;
-  o.num_threads = 1;
   ceres::Solver::Summary s;
-  ceres::Solve(o, &problem, &s);
+  ceres::Solve(denseSolverOptions({max_iterations, 1e-12, 1e-12, 1e-14}), &problem, &s);
   if (converged) *converged = s.IsSolutionUsable();
   return unpack(x.data(), L, start.f_ref_hz);
 }
