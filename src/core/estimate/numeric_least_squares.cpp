@@ -10,9 +10,8 @@
 namespace cvg_bench {
 namespace {
 
-/// The residual function as a Ceres cost with a central-difference Jacobian whose step is
-/// h = 1e-6 (1 + |p_k|): absolute near 0, where a relative step (Ceres' numeric differentiation)
-/// vanishes for an offset or a rate that passes close to 0.
+/// The residual function as a Ceres cost with centralDifferenceJacobian's Jacobian (Ceres' own
+/// numeric differentiation takes a relative step).
 class FunctionCost : public ceres::CostFunction {
  public:
   FunctionCost(const ResidualFunction* fn, int n_params, int n_residuals, Eigen::VectorXd* best_p,
@@ -30,17 +29,10 @@ class FunctionCost : public ceres::CostFunction {
     // Jacobian that cannot be evaluated next to a refused region), a loop keeps its progress.
     if (r.squaredNorm() < *best_sse_) *best_sse_ = r.squaredNorm(), *best_p_ = p;
     if (jacobians == nullptr || jacobians[0] == nullptr) return true;
-    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(
-        jacobians[0], n, k);
-    Eigen::VectorXd rp, rm;
-    for (int c = 0; c < k; ++c) {
-      const double h = 1e-6 * (1.0 + std::fabs(p(c)));
-      Eigen::VectorXd pp = p, pm = p;
-      pp(c) += h;
-      pm(c) -= h;
-      if (!eval(pp, rp) || !eval(pm, rm)) return false;
-      J.col(c) = (rp - rm) / (2.0 * h);
-    }
+    Eigen::MatrixXd J;
+    if (!centralDifferenceJacobian(*fn_, p, J) || J.rows() != n) return false;
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(jacobians[0],
+                                                                                       n, k) = J;
     return true;
   }
 
@@ -54,6 +46,23 @@ class FunctionCost : public ceres::CostFunction {
 };
 
 }  // namespace
+
+bool centralDifferenceJacobian(const ResidualFunction& residuals, const Eigen::VectorXd& p,
+                               Eigen::MatrixXd& J) {
+  Eigen::VectorXd rp, rm;
+  for (int c = 0; c < p.size(); ++c) {
+    const double h = 1e-6 * (1.0 + std::fabs(p(c)));
+    Eigen::VectorXd pp = p, pm = p;
+    pp(c) += h;
+    pm(c) -= h;
+    if (!residuals(pp, rp) || !residuals(pm, rm) || rp.size() != rm.size() ||
+        (c > 0 && rp.size() != J.rows()) || !rp.allFinite() || !rm.allFinite())
+      return false;
+    if (c == 0) J.resize(rp.size(), p.size());
+    J.col(c) = (rp - rm) / (2.0 * h);
+  }
+  return true;
+}
 
 bool minimizeSumOfSquares(const ResidualFunction& residuals, Eigen::VectorXd& p, double& sse,
                           int max_iterations) {

@@ -40,20 +40,14 @@ bool residuals(const std::string& model, const Eigen::VectorXd& p, const Data& d
   return true;
 }
 
-/// Jacobian of the weighted model sqrt(w) f(p) by central differences.
+/// Jacobian of the weighted model sqrt(w) f(p) (= -d r / dp) by central differences.
 bool jacobian(const std::string& model, const Eigen::VectorXd& p, const Data& d, double floor_rel,
               Eigen::MatrixXd& J) {
-  J.resize(d.t.size(), p.size());
-  Eigen::VectorXd rp, rm;
-  for (int k = 0; k < p.size(); ++k) {
-    const double h = 1e-6 * (1.0 + std::fabs(p(k)));
-    Eigen::VectorXd pp = p, pm = p;
-    pp(k) += h;
-    pm(k) -= h;
-    if (!residuals(model, pp, d, floor_rel, rp) || !residuals(model, pm, d, floor_rel, rm))
-      return false;
-    J.col(k) = -(rp - rm) / (2.0 * h);  // d(sqrt(w) f)/dp
-  }
+  const ResidualFunction r = [&](const Eigen::VectorXd& q, Eigen::VectorXd& out) {
+    return residuals(model, q, d, floor_rel, out);
+  };
+  if (!centralDifferenceJacobian(r, p, J)) return false;
+  J = -J;
   return true;
 }
 
@@ -64,14 +58,15 @@ RingdownValue deltaValue(const std::function<double(const Eigen::VectorXd&)>& fn
                          const Eigen::MatrixXd& cov_crb, double z) {
   RingdownValue v;
   v.value = fn(p);
-  Eigen::VectorXd grad(p.size());
-  for (int k = 0; k < p.size(); ++k) {
-    const double h = 1e-6 * (1.0 + std::fabs(p(k)));
-    Eigen::VectorXd pp = p, pm = p;
-    pp(k) += h;
-    pm(k) -= h;
-    grad(k) = (fn(pp) - fn(pm)) / (2.0 * h);
-  }
+  const ResidualFunction value = [&](const Eigen::VectorXd& q, Eigen::VectorXd& out) {
+    out = Eigen::VectorXd::Constant(1, fn(q));
+    return true;
+  };
+  Eigen::MatrixXd g;
+  // A value that is not finite next to p leaves a NaN gradient (its std then reads 0, as before).
+  const Eigen::VectorXd grad = centralDifferenceJacobian(value, p, g)
+                                   ? Eigen::VectorXd(g.row(0).transpose())
+                                   : Eigen::VectorXd::Constant(p.size(), NAN);
   v.std = std::sqrt(std::max(0.0, grad.dot(cov * grad)));
   v.crb_std = std::sqrt(std::max(0.0, grad.dot(cov_crb * grad)));
   v.ci_low = v.value - z * v.std;
