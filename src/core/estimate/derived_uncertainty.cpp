@@ -112,6 +112,54 @@ bool contains(const std::vector<std::string>& v, const std::string& x) {
   return std::find(v.begin(), v.end(), x) != v.end();
 }
 
+/// The parameters among `suspects` that move the derived quantity `key` (a step of 1e-3 (1 + |v|)
+/// changes it by more than 1e-9 of its size).
+std::vector<std::string> dependsOn(const ParameterValues& values, const std::string& key,
+                                   const std::vector<std::string>& suspects, double omega_rad_s,
+                                   double angular_gain_k) {
+  std::vector<std::string> out;
+  const double v0 = deriveQuantities(values, omega_rad_s, angular_gain_k).asMap().at(key);
+  for (const auto& name : suspects) {
+    const auto it = values.find(name);
+    if (it == values.end()) continue;
+    ParameterValues moved = values;
+    moved[name] = it->second + 1e-3 * (1.0 + std::fabs(it->second));
+    try {
+      const double v1 = deriveQuantities(moved, omega_rad_s, angular_gain_k).asMap().at(key);
+      if (!(std::fabs(v1 - v0) <= 1e-9 * (1.0 + std::fabs(v0)))) out.push_back(name);
+    } catch (const InputError&) {
+      out.push_back(name);
+    }
+  }
+  return out;
+}
+
+/// Issue #25: a derived figure computed from a parameter the record does not identify (VIF >=
+/// 1e4, collinearity.h) is no estimate; it is removed and a note names what it needs. Q is left
+/// to the envelope rule below (Q_envelope stands in for omega/gamma).
+void dropFiguresOfUnidentified(Estimate* e, double omega_rad_s, double angular_gain_k) {
+  if (e->not_identified.empty()) return;
+  ParameterValues values;
+  for (size_t j = 0; j < e->names.size() && static_cast<Eigen::Index>(j) < e->values.size(); ++j)
+    values[e->names[j]] = e->values[static_cast<Eigen::Index>(j)];
+  for (auto it = e->derived.begin(); it != e->derived.end();) {
+    const std::vector<std::string> needs =
+        it->first == "Q"
+            ? std::vector<std::string>{}
+            : dependsOn(values, it->first, e->not_identified, omega_rad_s, angular_gain_k);
+    if (needs.empty()) {
+      ++it;
+      continue;
+    }
+    std::string list;
+    for (const auto& n : needs) list += (list.empty() ? "" : ", ") + n;
+    const std::string note = it->first + " not reported: it depends on " + list +
+                             ", which this record does not identify";
+    if (!contains(e->notes, note)) e->notes.push_back(note);
+    it = e->derived.erase(it);
+  }
+}
+
 }  // namespace
 
 void deriveFromIdentified(Estimate* e, double omega_rad_s, double angular_gain_k) {
@@ -130,6 +178,7 @@ void deriveFromIdentified(Estimate* e, double omega_rad_s, double angular_gain_k
     } catch (const InputError& err) {
       e->notes.push_back(std::string("derived quantities not computed: ") + err.what());
     }
+    dropFiguresOfUnidentified(e, omega_rad_s, angular_gain_k);
   }
   const Eigen::VectorXd& c = e->envelope_coefficients;
   if (!full_rank || c.size() != k || e->values.size() != k || e->covariance.rows() != k) return;

@@ -73,5 +73,42 @@ TEST(DerivedUncertainty, WindowMeanDriftIsTheMeanWithTheMeansInterval) {
   EXPECT_THROW(meanDriftRateWithInterval({}, p), InputError);
 }
 
+Estimate estimateOf(const UncertainParameters& p) {
+  Estimate e;
+  e.names = p.cov_names;
+  e.values.resize(static_cast<Eigen::Index>(e.names.size()));
+  for (size_t j = 0; j < e.names.size(); ++j) e.values[j] = p.values.at(e.names[j]);
+  e.covariance = p.covariance;
+  e.n_params = e.rank = static_cast<int>(e.names.size());
+  e.confidence = 0.95;
+  e.interval_dof = p.dof;
+  return e;
+}
+
+// Issue #25: a figure derived from a parameter the record does not identify is not printed as a
+// number; the figures that do not need it stay, with the same values.
+TEST(DerivedUncertainty, FiguresOfAParameterNotIdentifiedAreNotReported) {
+  Estimate e = estimateOf(example());
+  deriveFromIdentified(&e, 85732.0, 0.4);
+  const auto all = e.derived;
+  ASSERT_TRUE(all.count("frequency_split_hz") && all.count("zero_rate_rad_s"));
+  e.not_identified = {"h_c"};
+  deriveFromIdentified(&e, 85732.0, 0.4);
+  deriveFromIdentified(&e, 85732.0, 0.4);  // said once
+  for (const char* k : {"frequency_split_hz", "frequency_split_rad_s", "alpha_rad"})
+    EXPECT_EQ(e.derived.count(k), 0u) << k;
+  for (const char* k :
+       {"zero_rate_rad_s", "frequency_error_hz", "damping_anisotropy_1_s", "beta_rad", "Q"}) {
+    ASSERT_EQ(e.derived.count(k), 1u) << k;
+    EXPECT_DOUBLE_EQ(e.derived.at(k).value, all.at(k).value) << k;
+  }
+  int notes = 0;
+  for (const auto& n : e.notes)
+    notes += n ==
+             "frequency_split_hz not reported: it depends on h_c, which this record does "
+             "not identify";
+  EXPECT_EQ(notes, 1);
+}
+
 }  // namespace
 }  // namespace cvg_bench
