@@ -103,6 +103,28 @@ DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
     }
     start = i;
   }
+  // A bin passed once has only its pass's own (HAC) interval, which understates the noise of the
+  // pattern angle: the passes of the bins passed twice or more scatter about their means by more
+  // than their intervals say (quartz at k0 = 0.1: truth outside the one-pass intervals at z RMS
+  // ~2). So one-pass bins take the pooled ratio sqrt(chi^2 / dof) of those bins (at least 1) and
+  // Student's quantile at its dof; bins of several passes keep their own ratio (issue #26).
+  double chi2_pooled = 0.0;
+  int dof_pooled = 0;
+  for (const auto& passes : pass_rates) {
+    if (passes.size() < 2) continue;
+    double sw = 0, m = 0;
+    for (const auto& p : passes) {
+      const double w = 1.0 / std::max(p.std_error * p.std_error, 1e-300);
+      sw += w;
+      m += w * p.value;
+    }
+    m /= sw;
+    for (const auto& p : passes)
+      chi2_pooled += (p.value - m) * (p.value - m) / std::max(p.std_error * p.std_error, 1e-300);
+    dof_pooled += static_cast<int>(passes.size()) - 1;
+  }
+  out.one_pass_scale = dof_pooled > 0 ? std::max(1.0, std::sqrt(chi2_pooled / dof_pooled)) : 1.0;
+  out.one_pass_scale_dof = dof_pooled;
   const ResonatorModel model = freeOscillationModelOf(params.values);
   out.model = model.spec();
   std::vector<double> centres, meas, pred, diff;
@@ -113,6 +135,13 @@ DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
     bin.passes = static_cast<int>(pass_rates[b].size());
     if (bin.passes == 1) {
       bin.measured = pass_rates[b][0];
+      if (dof_pooled > 0) {
+        ParameterEstimate& m = bin.measured;
+        m.std_error *= out.one_pass_scale;
+        const double s = studentQuantile(confidence, dof_pooled);
+        m.ci_low = m.value - s * m.std_error;
+        m.ci_high = m.value + s * m.std_error;
+      }
       bin.measured_ok = true;
     } else if (bin.passes >= 2) {
       // Inverse-variance mean of the passes; its std scaled up by the Birge ratio when the passes

@@ -44,6 +44,12 @@ struct DriftComparison {
   double rms_difference_rad_s = 0.0;  ///< RMS over bins of measured - predicted
   double rms_measured_rad_s = 0.0;    ///< RMS over bins of the measured drift (uncompensated)
   int bins_measured = 0;
+  /// The factor on the interval of a bin passed once: the passes' scatter about their bin means
+  /// against their own intervals, pooled over the bins passed twice or more (sqrt(chi^2 / dof),
+  /// at least 1), with Student's quantile at one_pass_scale_dof (0: no bin passed twice, 1-pass
+  /// bins keep their own interval).
+  double one_pass_scale = 1.0;
+  int one_pass_scale_dof = 0;
   std::string summary;
 };
 
