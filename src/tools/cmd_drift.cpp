@@ -163,8 +163,13 @@ int runMeasuredDrift(const CliArgs& args, const UncertainParameters& up) {
   j["confidence"] = up.confidence;
   j["method"] =
       "measured: slopes of the unwrapped pattern angle over passes through each theta bin, walk "
-      "subtracted, mean of passes with a Student-t interval (one pass: HAC); predicted: theta' of "
-      "the model by the chain rule at the run's median r, k, delta-method interval";
+      "subtracted, inverse-variance mean of the passes; slope errors from the noise pooled over "
+      "all passes (AR(1) long-run factor), widened by the passes' scatter ratio where they "
+      "scatter more; predicted: theta' of the model by the chain rule at the run's median r, k, "
+      "delta-method interval";
+  j["noise_lag1"] = c.noise_lag1;
+  j["pass_scatter_ratio"] = c.pass_scatter_ratio;
+  j["pass_scatter_dof"] = c.pass_scatter_dof;
   if (args.has("json")) writeJsonFile(j, args.get("json"));
   if (args.has("png")) {
     // The angle-dependent drift plot (scripts/drift_plot.py) from this JSON.

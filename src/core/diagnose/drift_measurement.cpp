@@ -3,9 +3,9 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
-#include "cvg_bench/core/estimate/internal/hac_slope.h"
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
@@ -18,6 +18,32 @@ namespace {
 
 double median(const std::vector<double>& v) {
   return sampleMedian(v);
+}
+
+/// What a pass through the bin [c - w/2, c + w/2] measures: the slope of theta(t) across it is
+/// w / (time to cross) = the harmonic mean of the walk + theta'(theta) over the bin, less the walk
+/// (Simpson over 9 points). The bin centre's theta' differs from it by the drift's curvature and
+/// spread over the bin, which on a long run (narrow intervals) is several of the measured
+/// intervals (quartz at k0 = 0: smooth runs of z 1.5-3 over neighbouring bins). The centre's value
+/// where the walk does not carry the pattern through the whole bin.
+ParameterEstimate binDriftWithInterval(const ResonatorModel& model, double r, double k, double c,
+                                       double w, double walk, const UncertainParameters& params) {
+  auto crossing = [&](const ParameterValues& v) {
+    constexpr int kPoints = 9;
+    double time = 0.0;
+    for (int i = 0; i < kPoints; ++i) {
+      const double th = c - w / 2 + w * i / (kPoints - 1);
+      const double rate =
+          walk + orbitRatesOfModel(model, v, OrbitElements{r, k, th, 0.0}).theta_dot;
+      if (!(rate * walk > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+      const double simpson = (i == 0 || i == kPoints - 1) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+      time += simpson / rate;
+    }
+    return w / (time * w / (3.0 * (kPoints - 1))) - walk;
+  };
+  if (walk == 0.0 || !std::isfinite(crossing(params.values)))
+    return driftRateWithInterval(r, k, c, params);
+  return deltaMethod(crossing, params);
 }
 
 }  // namespace
@@ -82,49 +108,98 @@ DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
     const double w = std::remainder(theta, M_PI / 2);  // [-pi/4, pi/4]
     return std::min(n_bins - 1, static_cast<int>(std::floor((w + M_PI / 4) / width)));
   };
-  std::vector<std::vector<ParameterEstimate>> pass_rates(n_bins);
+  // Each pass through a bin: the least-squares slope of theta(t) over it. Its standard error
+  // comes from the noise pooled over all passes (residual variance with sum(n - 2) dof, lag-1
+  // correlation as an AR(1) long-run factor), not from each pass alone: a pass of ~10 samples
+  // (quartz at k0 = 0.1) gave a HAC variance so noisy that the truth lay 2-3 of its intervals
+  // away in one bin of four (issue #26).
+  struct Pass {
+    int bin;
+    double slope, sxx;
+  };
+  std::vector<Pass> passes;
   std::vector<int> samples(n_bins, 0);
+  double sse = 0.0, lag1 = 0.0;
+  long noise_dof = 0;
+  // Samples are assigned to bins by a centred moving average of theta, not by their own noisy
+  // value: selecting a pass's samples by the value they are fitted on keeps those pushed into the
+  // bin by noise and drops those pushed out, which biases every slope low by a fraction of the
+  // whole rate (walk included; quartz at k0 = 0.1: 2-3 of a pass's interval). The window is about
+  // a quarter of a pass (2 .. 50 samples each side).
+  const double crossings = std::max(1.0, covered / width);
+  const int half = std::clamp(static_cast<int>(0.125 * t.size() / crossings), 2, 50);
+  std::vector<double> sel(th.size());
+  for (size_t i = 0; i < th.size(); ++i) {
+    const size_t lo = i >= static_cast<size_t>(half) ? i - half : 0;
+    const size_t hi = std::min(th.size() - 1, i + half);
+    const size_t w = std::min(i - lo, hi - i);  // symmetric: unbiased on a straight path
+    double sum = 0.0;
+    for (size_t j = i - w; j <= i + w; ++j) sum += th[j];
+    sel[i] = sum / static_cast<double>(2 * w + 1);
+  }
   size_t start = 0;
   for (size_t i = 1; i <= t.size(); ++i) {
-    if (i < t.size() && binOf(th[i]) == binOf(th[start])) continue;
-    const int b = binOf(th[start]);
+    if (i < t.size() && binOf(sel[i]) == binOf(sel[start])) continue;
+    const int b = binOf(sel[start]);
     samples[b] += static_cast<int>(i - start);
     // A pass counts when it crosses at least half the bin (fragments at the record's ends and
     // noise-driven re-entries would give slopes of a few samples).
-    const double travel = std::abs(th[i - 1] - th[start]);
+    const double travel = std::abs(sel[i - 1] - sel[start]);
     if (i - start >= 6 && travel >= 0.5 * width) {
-      const std::vector<double> tp(t.begin() + start, t.begin() + i),
-          yp(th.begin() + start, th.begin() + i);
-      ParameterEstimate p = hacSlope(tp, yp, confidence);
-      p.value -= walk_rad_s;
-      p.ci_low -= walk_rad_s;
-      p.ci_high -= walk_rad_s;
-      pass_rates[b].push_back(p);
+      const int n = static_cast<int>(i - start);
+      double tm = 0.0, ym = 0.0;
+      for (size_t j = start; j < i; ++j) tm += t[j], ym += th[j];
+      tm /= n;
+      ym /= n;
+      double sxx = 0.0, sxy = 0.0;
+      for (size_t j = start; j < i; ++j) {
+        sxx += (t[j] - tm) * (t[j] - tm);
+        sxy += (t[j] - tm) * (th[j] - ym);
+      }
+      const double slope = sxy / sxx;
+      double prev = 0.0;
+      for (size_t j = start; j < i; ++j) {
+        const double e = th[j] - ym - slope * (t[j] - tm);
+        sse += e * e;
+        if (j > start) lag1 += e * prev;
+        prev = e;
+      }
+      noise_dof += n - 2;
+      passes.push_back({b, slope - walk_rad_s, sxx});
     }
     start = i;
   }
-  // A bin passed once has only its pass's own (HAC) interval, which understates the noise of the
-  // pattern angle: the passes of the bins passed twice or more scatter about their means by more
-  // than their intervals say (quartz at k0 = 0.1: truth outside the one-pass intervals at z RMS
-  // ~2). So one-pass bins take the pooled ratio sqrt(chi^2 / dof) of those bins (at least 1) and
-  // Student's quantile at its dof; bins of several passes keep their own ratio (issue #26).
-  double chi2_pooled = 0.0;
-  int dof_pooled = 0;
-  for (const auto& passes : pass_rates) {
-    if (passes.size() < 2) continue;
-    double sw = 0, m = 0;
-    for (const auto& p : passes) {
-      const double w = 1.0 / std::max(p.std_error * p.std_error, 1e-300);
-      sw += w;
-      m += w * p.value;
-    }
-    m /= sw;
-    for (const auto& p : passes)
-      chi2_pooled += (p.value - m) * (p.value - m) / std::max(p.std_error * p.std_error, 1e-300);
-    dof_pooled += static_cast<int>(passes.size()) - 1;
+  const double s2 = noise_dof > 0 ? sse / static_cast<double>(noise_dof) : 0.0;
+  const double rho = sse > 0.0 ? std::clamp(lag1 / sse, 0.0, 0.9) : 0.0;
+  const double long_run = std::sqrt((1.0 + rho) / (1.0 - rho));
+  std::vector<double> weight(n_bins, 0.0), mean(n_bins, 0.0);
+  std::vector<int> count(n_bins, 0);
+  auto varianceOf = [&](const Pass& p) {
+    return std::max(s2 * long_run * long_run / p.sxx, 1e-300);
+  };
+  for (const Pass& p : passes) {
+    weight[p.bin] += 1.0 / varianceOf(p);
+    mean[p.bin] += p.slope / varianceOf(p);
+    count[p.bin] += 1;
   }
-  out.one_pass_scale = dof_pooled > 0 ? std::max(1.0, std::sqrt(chi2_pooled / dof_pooled)) : 1.0;
-  out.one_pass_scale_dof = dof_pooled;
+  for (int b = 0; b < n_bins; ++b)
+    if (count[b] > 0) mean[b] /= weight[b];
+  // Passes through one bin measure the same theta': their scatter about the bin means, pooled,
+  // checks the noise model; where they scatter more (slow noise, a wandering base), every
+  // interval is widened by that ratio, with Student's quantile at its dof.
+  double chi2 = 0.0;
+  int scatter_dof = 0;
+  for (const Pass& p : passes)
+    chi2 += (p.slope - mean[p.bin]) * (p.slope - mean[p.bin]) / varianceOf(p);
+  for (int b = 0; b < n_bins; ++b) scatter_dof += std::max(0, count[b] - 1);
+  out.pass_scatter_ratio = scatter_dof > 0 ? std::max(1.0, std::sqrt(chi2 / scatter_dof)) : 1.0;
+  out.pass_scatter_dof = scatter_dof;
+  out.noise_dof = noise_dof;
+  out.noise_lag1 = rho;
+  const double quantile =
+      out.pass_scatter_ratio > 1.0
+          ? studentQuantile(confidence, scatter_dof)
+          : studentQuantile(confidence, static_cast<int>(std::min<long>(noise_dof, 100000)));
   const ResonatorModel model = freeOscillationModelOf(params.values);
   out.model = model.spec();
   std::vector<double> centres, meas, pred, diff;
@@ -132,39 +207,16 @@ DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
     DriftBin bin;
     bin.theta_rad = -M_PI / 4 + (b + 0.5) * width;
     bin.samples = samples[b];
-    bin.passes = static_cast<int>(pass_rates[b].size());
-    if (bin.passes == 1) {
-      bin.measured = pass_rates[b][0];
-      if (dof_pooled > 0) {
-        ParameterEstimate& m = bin.measured;
-        m.std_error *= out.one_pass_scale;
-        const double s = studentQuantile(confidence, dof_pooled);
-        m.ci_low = m.value - s * m.std_error;
-        m.ci_high = m.value + s * m.std_error;
-      }
-      bin.measured_ok = true;
-    } else if (bin.passes >= 2) {
-      // Inverse-variance mean of the passes; its std scaled up by the Birge ratio when the passes
-      // scatter more than their own intervals say.
-      double sw = 0, m = 0;
-      for (const auto& p : pass_rates[b]) {
-        const double w = 1.0 / std::max(p.std_error * p.std_error, 1e-300);
-        sw += w;
-        m += w * p.value;
-      }
-      m /= sw;
-      double chi2 = 0;
-      for (const auto& p : pass_rates[b])
-        chi2 += (p.value - m) * (p.value - m) / std::max(p.std_error * p.std_error, 1e-300);
-      bin.measured.value = m;
-      bin.measured.std_error =
-          std::sqrt(1.0 / sw) * std::max(1.0, std::sqrt(chi2 / (bin.passes - 1)));
-      const double s = studentQuantile(confidence, bin.passes - 1);
-      bin.measured.ci_low = m - s * bin.measured.std_error;
-      bin.measured.ci_high = m + s * bin.measured.std_error;
+    bin.passes = count[b];
+    if (count[b] > 0) {
+      bin.measured.value = mean[b];
+      bin.measured.std_error = std::sqrt(1.0 / weight[b]) * out.pass_scatter_ratio;
+      bin.measured.ci_low = mean[b] - quantile * bin.measured.std_error;
+      bin.measured.ci_high = mean[b] + quantile * bin.measured.std_error;
       bin.measured_ok = true;
     }
-    bin.predicted = driftRateWithInterval(out.r, out.k, bin.theta_rad, params);
+    bin.predicted =
+        binDriftWithInterval(model, out.r, out.k, bin.theta_rad, width, walk_rad_s, params);
     if (bin.measured_ok) {
       centres.push_back(bin.theta_rad);
       meas.push_back(bin.measured.value);

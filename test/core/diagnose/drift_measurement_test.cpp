@@ -18,7 +18,6 @@ namespace {
 
 struct Coverage {
   int inside = 0, bins = 0, one_pass = 0, one_pass_inside = 0;
-  int one_pass_inside_unscaled = 0;  ///< by the pass's own interval (std / scale, normal 95 %)
 };
 
 /// Runs of the preset held at (0.5, k0), seeds 1..n, measured against the truth's prediction
@@ -46,7 +45,8 @@ Coverage coverageOver(const std::string& preset_name, double k0, int n) {
     const SlowRecord run = simulateWholeAngle(preset, o);
     const double walk = std::stod(run.metadata.at("whole_angle_walk_rad_s"));
     const DriftComparison d = measureDrift(run, walk, truth);
-    EXPECT_GE(d.one_pass_scale, 1.0);
+    EXPECT_GE(d.pass_scatter_ratio, 1.0);
+    EXPECT_GT(d.noise_dof, 100);
     for (const DriftBin& b : d.bins) {
       if (!b.measured_ok) continue;
       const bool in =
@@ -56,25 +56,21 @@ Coverage coverageOver(const std::string& preset_name, double k0, int n) {
       if (b.passes != 1) continue;
       c.one_pass += 1;
       c.one_pass_inside += in;
-      const double own = 1.959964 * b.measured.std_error / d.one_pass_scale;
-      c.one_pass_inside_unscaled += std::fabs(b.predicted.value - b.measured.value) <= own;
     }
   }
   return c;
 }
 
 // The run the drift validation found too confident (docs/validation_drift.md, k0 = 0.2 r0): a
-// bin passed once had only its pass's own interval, which left the true drift outside in ~1 bin
-// of 4 there. With the passes' pooled scatter those bins cover it like the rest.
+// bin passed once had only its pass's own HAC interval (~10 samples), which covered the true
+// drift in 76 of these 112 one-pass bins. The noise pooled over all passes covers it like the
+// rest.
 TEST(DriftMeasurement, IntervalsCoverTheTrueDriftAtQuadrature) {
   const Coverage c = coverageOver("quartz_cylinder", 0.1, 8);
   ASSERT_GT(c.one_pass, 20);
   EXPECT_GE(c.inside, static_cast<int>(0.88 * c.bins)) << c.inside << " of " << c.bins;
   EXPECT_GE(c.one_pass_inside, static_cast<int>(0.85 * c.one_pass))
       << c.one_pass_inside << " of " << c.one_pass;
-  // What the pass's own interval gave (the measurement before 29 Nov).
-  EXPECT_LT(c.one_pass_inside_unscaled, static_cast<int>(0.85 * c.one_pass))
-      << c.one_pass_inside_unscaled << " of " << c.one_pass;
 }
 
 TEST(DriftMeasurement, IntervalsCoverTheTrueDriftHeldAtZeroQuadrature) {

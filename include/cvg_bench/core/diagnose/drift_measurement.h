@@ -44,12 +44,15 @@ struct DriftComparison {
   double rms_difference_rad_s = 0.0;  ///< RMS over bins of measured - predicted
   double rms_measured_rad_s = 0.0;    ///< RMS over bins of the measured drift (uncompensated)
   int bins_measured = 0;
-  /// The factor on the interval of a bin passed once: the passes' scatter about their bin means
-  /// against their own intervals, pooled over the bins passed twice or more (sqrt(chi^2 / dof),
-  /// at least 1), with Student's quantile at one_pass_scale_dof (0: no bin passed twice, 1-pass
-  /// bins keep their own interval).
-  double one_pass_scale = 1.0;
-  int one_pass_scale_dof = 0;
+  /// The noise of the pattern angle pooled over all passes: residual dof and lag-1 correlation
+  /// (its AR(1) long-run factor widens every pass's slope error).
+  long noise_dof = 0;
+  double noise_lag1 = 0.0;
+  /// The passes' scatter about their bin means against those errors, pooled over the bins passed
+  /// twice or more (sqrt(chi^2 / dof), at least 1): every bin's interval is widened by it, with
+  /// Student's quantile at pass_scatter_dof when it exceeds 1.
+  double pass_scatter_ratio = 1.0;
+  int pass_scatter_dof = 0;
   std::string summary;
 };
 
