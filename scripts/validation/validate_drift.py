@@ -32,10 +32,13 @@ quadrature +-k0 in turn (decays started at k = 0 bound the cubic terms' r k acti
 and the added xi_diff is sized so that its own theta' swing at (r0, k0) is 0.3 of the preset's
 peak drift there. Target the same, fixed before the first pooled run at k0 = 0.2. mems_ring also
 has a case identified from one forced sweep (its experiment in the paper's section 4).
---jobs N: pooled seeds run N at a time.
+--jobs N: pooled seeds run N at a time. --cases A,B: only the pooled cases whose label holds A or B.
+At k0 != 0 xi_k and kappa (the other terms that move theta' through r k) are added and left out
+as xi_diff is, sized the same way.
 
 usage: validate_drift.py [--out DIR] [--markdown FILE] [--seed N] [--decays N] [--pool N] [--pool-only]
                          [--pool-cases shipped|all] [--k0 FRACTION_OF_R0] [--jobs N]
+                         [--cases LABEL_PART,...]
 """
 import concurrent.futures
 import json
@@ -77,6 +80,7 @@ def header(path):
 # xi_diff shows only through the bias it leaves in the other parameters; at k0 != 0 directly.
 K0_FRACTION = 0.0
 JOBS = 1  # --jobs N: pooled seeds run N at a time
+CASES = []  # --cases A,B: only the pooled cases whose label holds one of these
 
 
 def drift_scale(truth, r0):
@@ -97,6 +101,21 @@ def drift_curve(params, omega, work, tag, r0, k0):
         raise RuntimeError("drift (sizing): " + err.strip()[-200:])
     with open(gj) as f:
         return [g["drift_rad_s"] for g in json.load(f)["drift"]]
+
+
+def term_size(truth, r0, work, preset, term):
+    """A size for `term` (xi_k, kappa) whose own theta' swing at (r0, k0) is 0.3 of the preset's
+    peak drift there, as xi_diff's (k0 != 0 only: these act through r k)."""
+    k0 = K0_FRACTION * r0
+    omega = float(header(os.path.join(work, preset + "_probe.csv"))["omega"])
+    params = {k: v for k, v in truth.items() if k != "model"}
+    base = drift_curve(params, omega, work, preset + "_base", r0, k0)
+    with_unit = drift_curve(dict(params, **{term: params.get(term, 0.0) + 1.0}), omega, work,
+                            preset + "_unit_" + term, r0, k0)
+    unit = max(abs(a - b) for a, b in zip(with_unit, base))
+    if unit <= 0.0:
+        raise RuntimeError("%s = 1 does not move theta' at k0 = %g" % (term, k0))
+    return 0.3 * max(abs(b) for b in base) / unit
 
 
 def xi_diff_size(truth, r0, work, preset):
@@ -129,7 +148,15 @@ def case_list(preset, truth, r0, work="."):
         ("+ xi_diff", ["xi_diff=%g" % v], base_terms + ["xi_diff"]),
         ("+ xi_diff, identified without it", ["xi_diff=%g" % v], base_terms),
         ("+ xi_diff + gamma_nl (two at once)", ["xi_diff=%g" % v, both], base_terms + ["xi_diff", "gamma_nl"]),
-    ] + ([("sweep: resonator as shipped", [], base_terms)] if preset in SWEEP_PRESETS else [])
+    ] + ([("sweep: resonator as shipped", [], base_terms)] if preset in SWEEP_PRESETS else []) + \
+        [c for term in (("xi_k", "kappa") if K0_FRACTION != 0.0 else ())
+         for c in term_cases(truth, r0, work, preset, base_terms, term)]
+
+
+def term_cases(truth, r0, work, preset, base_terms, term):
+    """At k0 != 0: the other terms that move theta' through r k, added and left out (30 Nov)."""
+    e = ["%s=%g" % (term, term_size(truth, r0, work, preset, term))]
+    return [("+ " + term, e, base_terms + [term]), ("+ " + term + ", identified without it", e, base_terms)]
 
 
 def one(preset, label, effects, terms, work, seed, decays):
@@ -238,6 +265,8 @@ def pooled_rows(work, seed, decays, pool, all_cases=False):
         shipped = [t for t in truth["model"].split("+") if t != "linear"]
         cases = case_list(preset, truth, 0.5, work) if all_cases else [("resonator as shipped", [], shipped)]
         for label, effects, terms in cases:
+            if CASES and not any(c in label for c in CASES):
+                continue
             lines.append(pooled_case(work, seed, decays, pool, preset, label, effects, terms))
     return lines
 
@@ -268,9 +297,10 @@ def pooled_case(work, seed, decays, pool, preset, label, effects, terms):
 
 
 def main():
-    global K0_FRACTION, JOBS
+    global K0_FRACTION, JOBS, CASES
     K0_FRACTION = arg("--k0", 0.0)
     JOBS = arg("--jobs", 1)
+    CASES = [c for c in arg("--cases", "").split(",") if c]
     seed = arg("--seed", 4100)
     pool = arg("--pool", 10)
     decays = arg("--decays", 8)
