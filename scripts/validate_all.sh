@@ -29,7 +29,7 @@ fi
 if [ -f scripts/validation/validate_drift.py ]; then
   /usr/bin/python3 scripts/validation/validate_drift.py --out build/validate_drift
   # Held at quadrature k0 = 0.2 r0, where the cubic terms and xi_diff move theta' (every case
-  # pooled over 10 seeds, decays started at +-k0; docs/validation_drift.md; ~11 min on 2 cores).
+  # pooled over 10 seeds, decays started at +-k0; docs/validation_drift.md; ~20 min on 2 cores).
   /usr/bin/python3 scripts/validation/validate_drift.py --k0 0.2 --pool-only --pool-cases all \
     --pool 10 --jobs "${VALIDATE_JOBS:-2}" --out build/validate_drift_k0
 fi
