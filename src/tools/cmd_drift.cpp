@@ -166,6 +166,7 @@ int runMeasuredDrift(const CliArgs& args, const UncertainParameters& up) {
       "subtracted, inverse-variance mean of the passes; slope errors from the noise pooled over "
       "all passes (AR(1) long-run factor), widened by the passes' scatter ratio where they "
       "scatter more; predicted: theta' of the model by the chain rule at the run's median r, k, "
+      "harmonic mean of walk + theta' across each bin less the walk (what a pass measures), "
       "delta-method interval";
   j["noise_lag1"] = c.noise_lag1;
   j["pass_scatter_ratio"] = c.pass_scatter_ratio;

@@ -2,14 +2,15 @@
 // identify -> predict chain closed on a record, and what compensation with the prediction leaves.
 //
 // Measured: the pattern angle theta of every slow sample ((5.2), unwrapped), binned over one period
-// of theta (pi/2, where theta is defined); a pass is a run of consecutive samples in one bin that
-// crosses at least half of it; its rate is the least-squares slope of theta on t (HAC standard
-// error: correlated noise inside a pass stays honest) minus the known walk (base rotation). A
-// bin's measured theta' is the inverse-variance mean of its passes, its std scaled by the Birge
-// ratio when they scatter more than their intervals say (Student-t, passes - 1 dof), or the one
-// pass's own.
-// Predicted: theta' of the model (chain rule, every term) at the run's median r, k and the bin's
-// centre, with its delta-method interval. Harmonics: least squares of c0 + a4 cos 4 theta +
+// of theta (pi/2, where theta is defined) by a centred moving average of theta (not by each
+// sample's own noisy value); a pass is a run of consecutive samples in one bin that crosses at
+// least half of it; its rate is the least-squares slope of theta on t minus the known walk (base
+// rotation), its error from the noise pooled over all passes (AR(1) long-run factor). A bin's
+// measured theta' is the inverse-variance mean of its passes; every interval is widened by the
+// passes' scatter ratio about their bin means where they scatter more than their errors say.
+// Predicted: what a pass measures - the harmonic mean of walk + theta' (chain rule, every term)
+// across the bin, less the walk, at the run's median r, k - with its delta-method interval (the
+// bin centre's theta' without a walk). Harmonics: least squares of c0 + a4 cos 4 theta +
 // b4 sin 4 theta + a8 cos 8 theta + b8 sin 8 theta (theta is defined modulo pi / 2, so the drift's
 // harmonics are multiples of 4 theta; the oscillation plane 2 theta sees them as 2 theta and 4
 // theta).
