@@ -23,20 +23,21 @@ double medianOf(const std::vector<double>& y, long a, long b) {
 }
 
 struct Step {
+  size_t i0 = 0;       ///< first sample of the step (of its ramp, for a slow one)
   size_t i = 0;        ///< first sample after the step
   double left = 0.0;   ///< level before [dB]
   double right = 0.0;  ///< level after [dB]
   double sharp = 0.0;  ///< jump over the local sd of sample-to-sample differences
 };
 
-/// Sharp steps of the level y_db (step 1 of the header), in time order.
-std::vector<Step> findSteps(const std::vector<double>& y_db, const RingdownWindowOptions& o) {
+/// Sharp steps of the level y_db at half-width h (step 1 of the header), in time order.
+std::vector<Step> stepsAtScale(const std::vector<double>& y_db, long h, double min_jump) {
   std::vector<Step> steps;
-  const long n = static_cast<long>(y_db.size()), h = std::max(1, o.step_half);
+  const long n = static_cast<long>(y_db.size());
   for (long i = 2 * h; i + 2 * h <= n; ++i) {
     const double L = medianOf(y_db, i - h, i), R = medianOf(y_db, i, i + h);
     const double jump = std::fabs(R - L);
-    if (!(jump >= o.step_db)) continue;
+    if (!(jump >= min_jump)) continue;
     const double L2 = medianOf(y_db, i - 2 * h, i - h), R2 = medianOf(y_db, i + h, i + 2 * h);
     if (!(std::fabs(L - L2) < jump / 3.0 && std::fabs(R2 - R) < jump / 3.0)) continue;
     // Local scatter of the differences over 10 samples each side, the jump itself left out.
@@ -54,11 +55,54 @@ std::vector<Step> findSteps(const std::vector<double>& y_db, const RingdownWindo
     // Keep the largest jump of a cluster of adjacent candidates.
     if (!steps.empty() && static_cast<long>(steps.back().i) + h >= i) {
       if (jump > std::fabs(steps.back().right - steps.back().left))
-        steps.back() = {size_t(i), L, R, sharp};
+        steps.back() = {size_t(i), size_t(i), L, R, sharp};
       continue;
     }
-    steps.push_back({static_cast<size_t>(i), L, R, sharp});
+    steps.push_back({static_cast<size_t>(i), static_cast<size_t>(i), L, R, sharp});
   }
+  return steps;
+}
+
+/// Steps of step 1 of the header: sharp ones over step_half samples, and rising ramps of up to
+/// ramp_scale * step_half samples that raise the level by end_step_db or more (a drive toggled
+/// on through a detector's filter, D197 of the development set: 60 dB over ~24 samples, which a
+/// 3-sample comparison reads as a slope). A ramp's i0 is its first sample, i the first after it.
+std::vector<Step> findSteps(const std::vector<double>& y_db, const RingdownWindowOptions& o) {
+  const long h = std::max(1, o.step_half);
+  std::vector<Step> steps = stepsAtScale(y_db, h, o.step_db);
+  for (const int scale : {4, 10}) {
+    const long H = h * scale;
+    if (scale > o.ramp_scale) break;
+    for (Step r : stepsAtScale(y_db, H, o.end_step_db)) {
+      // Only rises: a fall of 20 dB over 10-30 samples is as often the decay itself (a fast first
+      // stage, a short record) as a step (the development set's D201, D204: -60 dB "ramps").
+      if (!(r.right > r.left)) continue;
+      // The ramp's ends: the last sample at the left level and the first at the right one (within
+      // a tenth of the jump), searched within H samples of the step.
+      const double tol = 0.1 * std::fabs(r.right - r.left);
+      size_t a = r.i, b = r.i;
+      while (a > 0 && r.i - a < size_t(H) &&
+             !(std::isfinite(y_db[a - 1]) && std::fabs(y_db[a - 1] - r.left) <= tol))
+        --a;
+      while (b < y_db.size() && b - r.i < size_t(H) &&
+             !(std::isfinite(y_db[b]) && std::fabs(y_db[b] - r.right) <= tol))
+        ++b;
+      // Sharp steps found within the ramp are part of it: the ramp replaces them when it changes
+      // the level further (a 3-sample comparison sees only part of a ramp's height).
+      r.i0 = a, r.i = std::max(b, a + 1);
+      const double jump = std::fabs(r.right - r.left);
+      bool larger_known = false;
+      for (const Step& s : steps)
+        larger_known =
+            larger_known || (s.i + h >= a && s.i <= b + h && std::fabs(s.right - s.left) >= jump);
+      if (larger_known) continue;
+      steps.erase(std::remove_if(steps.begin(), steps.end(),
+                                 [&](const Step& s) { return s.i + h >= a && s.i <= b + h; }),
+                  steps.end());
+      steps.push_back(r);
+    }
+  }
+  std::sort(steps.begin(), steps.end(), [](const Step& x, const Step& y) { return x.i < y.i; });
   return steps;
 }
 
@@ -130,15 +174,15 @@ RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vecto
       why << (why.tellp() > 0 ? "; " : "") << "a step of " << jump << " dB at switch-off ("
           << t[s.i] << " s): the decay is read after it";
     } else if (comes_on_again) {
-      const size_t end = s.i > static_cast<size_t>(o.step_half) ? s.i - o.step_half : s.i;
+      const size_t end = s.i0 > static_cast<size_t>(o.step_half) ? s.i0 - o.step_half : s.i0;
       if (end > w.first) earlier.push_back({w.first, end, why.str()});
       w.first = s.i;
       why << (why.tellp() > 0 ? "; " : "") << "the drive comes on again at " << t[s.i]
           << " s: the last ring-down is read";
     } else if (std::fabs(jump) >= o.end_step_db || s.sharp >= o.end_step_sharpness) {
-      w.last = s.i > static_cast<size_t>(o.step_half) ? s.i - o.step_half : s.i;
+      w.last = s.i0 > static_cast<size_t>(o.step_half) ? s.i0 - o.step_half : s.i0;
       why << (why.tellp() > 0 ? "; " : "") << "a step of " << (jump > 0 ? "+" : "") << jump
-          << " dB in " << o.step_half << " samples at " << t[s.i]
+          << " dB in " << std::max<size_t>(o.step_half, s.i - s.i0) << " samples at " << t[s.i0]
           << " s after the decay began (the mode leaves the detector's band, or the detector "
              "changes range or stops): the record is read up to "
           << t[w.last - 1] << " s";

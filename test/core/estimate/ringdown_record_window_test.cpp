@@ -112,5 +112,47 @@ TEST(RingdownWindow, ARerunWithAFullDecayIsReadLast) {
   EXPECT_NE(w.why.find("the last ring-down is read"), std::string::npos) << w.why;
 }
 
+TEST(RingdownWindow, ADriveToggledOnThroughARampIsAReexcitation) {
+  // D197 of the development set: the drive toggles between 0 dB and a -60 dB decay, each change
+  // a 24-sample ramp through the detector's filter (a 3-sample comparison reads it as a slope);
+  // after the last toggle a 0.1 dB/s decay. The window starts at the last rise, not before the
+  // toggles (where the earlier plateaus and ramps sit inside the "decay").
+  auto ramp = [](double t, double t0, double from, double to) {
+    const double u = std::min(1.0, std::max(0.0, (t - t0) / 24.0));
+    return from + (to - from) * u;
+  };
+  const Rec r = make(1400, [&](double t) {
+    if (t < 100) return 0.0;
+    if (t < 250) return ramp(t, 100, 0.0, -60.0);
+    if (t < 400) return ramp(t, 250, -60.0, 0.0);
+    if (t < 550) return ramp(t, 400, 0.0, -60.0);
+    if (t < 700) return ramp(t, 550, -60.0, 0.0);
+    return ramp(t, 700, 0.0, -60.0) - 0.1 * std::max(0.0, t - 724);
+  });
+  const RingdownWindow w = findRingdownWindow(r.t, r.y);
+  EXPECT_GE(w.first, 550u) << w.why;  // after the last rise's first sample ...
+  EXPECT_LE(w.first, 700u) << w.why;  // ... and before the last switch-off
+  EXPECT_EQ(w.last, 1400u);
+  EXPECT_NE(w.why.find("the drive comes on again at 57"), std::string::npos) << w.why;
+  // Without the ramp reading the last rise is not seen (what the tool did before 29 Nov).
+  RingdownWindowOptions sharp_only;
+  sharp_only.ramp_scale = 1;
+  EXPECT_EQ(findRingdownWindow(r.t, r.y, sharp_only).why.find("comes on again at 57"),
+            std::string::npos);
+}
+
+TEST(RingdownWindow, AFastFallIsNotARamp) {
+  // A decay whose first 40 dB fall at 2 dB/sample (a fast first stage) then 0.05 dB/s: no step,
+  // the window is the whole record (D201, D204 of the development set).
+  const Rec r = make(1000, [](double t) {
+    if (t < 100) return 0.0;
+    if (t < 120) return -2.0 * (t - 100);
+    return -40.0 - 0.05 * (t - 120);
+  });
+  const RingdownWindow w = findRingdownWindow(r.t, r.y);
+  EXPECT_EQ(w.first, 0u) << w.why;
+  EXPECT_EQ(w.last, 1000u) << w.why;
+}
+
 }  // namespace
 }  // namespace cvg_bench

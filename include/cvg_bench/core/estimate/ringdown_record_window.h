@@ -7,7 +7,9 @@
 // head and a decay then a floor after it; this window gives it that shape:
 //  1. Steps: a sharp change of the smoothed level (medians of `step_half` samples either side
 //     differ by >= step_db and by 4 local difference sd, while each side's own change over the
-//     same number of samples is under a third of it).
+//     same number of samples is under a third of it); and rising ramps, the same over up to
+//     ramp_scale times as many samples for rises of end_step_db or more (the drive coming on
+//     through a detector's filter; a fall that fast may be the decay itself).
 //  2. The drive level is the peak of the smoothed envelope. A step down that starts within
 //     near_top_db of it after the peak is a switch-off step: the window starts after it. A step up
 //     back to within near_top_db is the drive coming on again: the window restarts there.
@@ -41,6 +43,11 @@ struct RingdownWindowOptions {
   double end_step_sharpness = 12.0;
   /// Samples on each side whose median is compared (and over which each side must be flat).
   int step_half = 3;
+  /// Rising ramps: the same comparison over 4 and 10 times step_half samples (up to ramp_scale
+  /// times) finds rises whose ramp takes up to that many samples (the drive toggled on through a
+  /// detector's filter: D197 of the development set, 60 dB over ~24 samples), when they raise the
+  /// level by end_step_db. Falls are not read so (a fast fall may be the decay itself).
+  int ramp_scale = 10;
   /// Within this of the peak level [dB]: still the drive level (switch-off, drive on again).
   double near_top_db = 6.0;
   /// A ring-down before a re-excitation is read instead of the last when it falls this much

@@ -35,6 +35,10 @@ namespace cvg_bench {
 struct RingdownSegmentationOptions {
   /// Fit down to this far above the noise floor [dB], 3..40.
   double floor_margin_db = 10.0;
+  /// ... unless the decay rises less than floor_margin_db + short_decay_db above the floor: then
+  /// the margin leaves short_decay_db of decay, but is not under min_floor_margin_db [dB].
+  double short_decay_db = 10.0;
+  double min_floor_margin_db = 4.0;
   /// A drop-out lies at least this far below its neighbours' median [dB] (and 8 robust sd).
   double dropout_depth_db = 3.0;
   /// Minimum decay in the span [dB] for a ring-down to be analysed.
@@ -51,6 +55,7 @@ struct RingdownSegment {
   bool has_floor = false;
   double floor_log_amplitude = 0.0;  ///< ln of the floor's rms amplitude (when has_floor)
   double floor_start_s = 0.0;        ///< where the envelope reaches the floor (when has_floor)
+  double floor_margin_db = 0.0;  ///< the span ends this far above a floor (confirmed or suspected)
   /// ln of a floor the decay bends towards but the record holds too little of to confirm (NaN
   /// when none); the span stops the margin above it without claiming a floor.
   double suspected_floor_log_amplitude = std::numeric_limits<double>::quiet_NaN();
