@@ -110,6 +110,22 @@ class WholeAngleDrift(unittest.TestCase):
         p = run(["drift", "--params", self.truth, "--measured", short], ok=(2,))
         self.assertIn("under 3/4 of its period", p.stderr)
 
+    def test_a_garbled_walk_header_is_an_input_error(self):
+        # The header was read by an unchecked strtod before 29 Nov: garbage gave a walk of 0.
+        bad = os.path.join(self.tmp.name, "bad_walk.csv")
+        with open(self.wa) as f, open(bad, "w") as g:
+            n = 0
+            for line in f:
+                if line.startswith("# whole_angle_walk_rad_s"):
+                    line, n = "# whole_angle_walk_rad_s: fast\n", n + 1
+                g.write(line)
+        self.assertEqual(n, 1)
+        p = run(["drift", "--params", self.truth, "--measured", bad], ok=(2,))
+        self.assertIn("whole_angle_walk_rad_s", p.stderr)
+        self.assertIn("'fast'", p.stderr)
+        # --walk overrides the header (the documented way out).
+        run(["drift", "--params", self.truth, "--measured", bad, "--walk", "2e-3"])
+
 
 if __name__ == "__main__":
     unittest.main()
