@@ -71,6 +71,24 @@ class RingdownCli(unittest.TestCase):
         self.assertEqual(p.returncode, 2)
         self.assertIn("bad.csv:5", p.stderr)
 
+    def test_method_is_ceres_or_refused(self):
+        # --method was accepted with --mode ringdown and ignored (issue #23): every ring-down fit
+        # is weighted least squares on ln A by Ceres, so ceres/wls_log run and the same Q comes
+        # out; ls or rls is an input error, not silently something else.
+        rec, a, b = self.path("m.csv"), self.path("a.json"), self.path("b.json")
+        run("simulate", "--mode", "ringdown", "--q", "2e5", "--frequency", "1e4", "--seed", "6",
+            "--out", rec)
+        self.assertEqual(run("identify", rec, "--mode", "ringdown", "--json", a).returncode, 0)
+        p = run("identify", rec, "--mode", "ringdown", "--method", "ceres", "--json", b)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertEqual(json.load(open(a))["derived_ci"]["Q"]["value"],
+                         json.load(open(b))["derived_ci"]["Q"]["value"])
+        self.assertEqual(json.load(open(b))["method"], "wls_log")
+        for cmd in ("identify", "explain"):
+            p = run(cmd, rec, "--mode", "ringdown", "--method", "ls")
+            self.assertEqual(p.returncode, 2, p.stdout + p.stderr)
+            self.assertIn("--method ls", p.stderr)
+
     def test_explain_report_writes_figures_and_summary(self):
         rec, rep = self.path("rep.csv"), self.path("report")
         run("simulate", "--mode", "ringdown", "--effect", "gamma_nl=0.15", "--floor-db", "-60",
