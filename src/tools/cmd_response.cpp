@@ -80,8 +80,8 @@ void printFit(const ResponseFit& f, std::ostream& os) {
      << " sweeps, " << f.n_drive_levels << " drive levels, response " << responseKindName(f.kind)
      << "\n";
   char buf[200];
-  for (const char* k :
-       {"f0_hz", "width_hz", "Q", "backbone_hz_per_amp2", "width_growth_hz_per_amp2"}) {
+  for (const char* k : {"f0_hz", "width_hz", "Q", "backbone_hz_per_amp2",
+                        "width_growth_hz_per_amp2", "gamma_nl_term"}) {
     const auto it = f.derived.find(k);
     if (it == f.derived.end()) continue;
     if (std::find(f.not_determined.begin(), f.not_determined.end(), k) != f.not_determined.end()) {

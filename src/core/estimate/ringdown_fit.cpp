@@ -13,6 +13,7 @@
 #include "cvg_bench/core/estimate/ringdown_models.h"
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/gamma_nl_conventions.h"
 #include "cvg_bench/core/model/sample_median.h"
 
 namespace cvg_bench {
@@ -510,6 +511,9 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
     putRate("decay_rate_1_s", g0);
     // Physical coefficient: rate = g0 + gamma_nl A^2 (A in the file's unit), or + gamma_a A.
     fit.parameters[model] = scaled(gn, 1.0 / (T * (sq ? a_ref * a_ref : a_ref)));
+    // The model term's coefficient (gamma_nl_conventions.h): 8 times the ring-down's.
+    if (sq)
+      fit.derived["gamma_nl_term"] = scaled(fit.parameters[model], kGammaNlTermPerRingdownRate);
     putQ("Q0", g0);
     const RingdownValue start_rate = deltaValue(
         [sq](const Eigen::VectorXd& q) { return q(1) + q(2) * std::exp((sq ? 2.0 : 1.0) * q(0)); },

@@ -13,6 +13,7 @@
 #include "cvg_bench/core/estimate/dense_solver_options.h"
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/model/gamma_nl_conventions.h"
 
 namespace cvg_bench {
 namespace {
@@ -732,6 +733,16 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
     throw AnalysisError("no resonance determined by these data: the width's interval [" +
                         std::to_string(w.ci_low) + ", " + std::to_string(w.ci_high) +
                         "] Hz reaches zero (noise only, or the mode outside the swept band)");
+  // The model term's coefficient (gamma_nl_conventions.h): 8 pi times the width growth.
+  const auto g = fit.derived.find("width_growth_hz_per_amp2");
+  if (g != fit.derived.end()) {
+    ResponseValue t = g->second;
+    for (double* v : {&t.value, &t.std, &t.ci_low, &t.ci_high}) *v *= kGammaNlTermPerWidthGrowthHz;
+    fit.derived["gamma_nl_term"] = t;
+    if (std::find(fit.not_determined.begin(), fit.not_determined.end(), g->first) !=
+        fit.not_determined.end())
+      fit.not_determined.push_back("gamma_nl_term");
+  }
   return fit;
 }
 
