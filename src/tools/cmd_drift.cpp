@@ -1,7 +1,6 @@
 // cvg_ident drift: the drift rate theta' of (5.9) (corrected, docs/paper.md item 4-5) at a given
 // (r, k, theta) or over a theta grid on [0, pi/2), from an identify JSON (or a flat parameter
 // file).
-#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -105,13 +104,9 @@ int runMeasuredDrift(const CliArgs& args, const UncertainParameters& up) {
     if (it != any.slow.metadata.end()) {
       // The header line is the walk the simulator wrote; anything else there is an input error
       // (it was read as 0 rad/s before 29 Nov, and every bin's prediction then left it out).
-      const std::string& s = it->second;
-      char* end = nullptr;
-      walk = std::strtod(s.c_str(), &end);
-      while (end && *end && std::isspace(static_cast<unsigned char>(*end))) ++end;
-      if (s.empty() || end == s.c_str() || *end != '\0' || !std::isfinite(walk))
-        throw InputError(path + ": header '# whole_angle_walk_rad_s': not a finite number: '" + s +
-                         "' (give the walk with --walk RAD_S)");
+      if (!parseFiniteNumber(it->second, &walk))
+        throw InputError(path + ": header '# whole_angle_walk_rad_s': not a finite number: '" +
+                         it->second + "' (give the walk with --walk RAD_S)");
     }
   }
   const long bins = args.getInt("bins", 24);

@@ -181,8 +181,6 @@ void writeReportFiles(const std::string& dir, const nlohmann::json& j, const Rin
       << b.Q.ci_high << "," << b.n << "\n";
 }
 
-}  // namespace
-
 /// `--method` with `--mode ringdown`: every ring-down fit is weighted least squares on ln A solved
 /// by Ceres (JSON "method": "wls_log"); `ceres` and `wls_log` name it, anything else is refused
 /// rather than ignored (issue #23: it was accepted and ignored).
@@ -194,6 +192,8 @@ void checkRingdownMethod(const CliArgs& args) {
                      ": ring-down fits are nonlinear (weighted least squares on ln A, solved by "
                      "Ceres); --method ceres (or wls_log) is the only one");
 }
+
+}  // namespace
 
 int runRingdownIdentify(const std::vector<std::string>& argv) {
   const CliArgs args(argv,

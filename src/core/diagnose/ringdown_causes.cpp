@@ -5,6 +5,7 @@
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "cvg_bench/core/estimate/ringdown_envelope.h"
@@ -431,15 +432,23 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
   // switch-off transient taken for a fast beating mode, a floor taken for a slow second stage);
   // the generator's true beats and two-stage decays stay within it (tuning base 41000000: 29 of 30
   // each). The amplitude laws report Q at zero amplitude, which differs from the line's by design.
+  // The rivals' hold-out errors are the same for every candidate tried: computed once, on demand.
+  std::optional<double> cv_lin, cv_laws;
   auto confirmCandidate = [&](int k) {
     RingdownStep& s = steps[k];
     s.hold_out_error = holdOutError(env, x.segment, fits[k], options.fit);
-    const double cv_lin = holdOutError(env, x.segment, x.baseline, options.fit);
-    double cv_rival = cv_lin;
-    if (!isAmplitudeLaw(s.added))
-      for (int j = 0; j < nc; ++j)
-        if (ok[j] && isAmplitudeLaw(steps[j].added) && steps[j].physical && steps[j].significant)
-          cv_rival = std::min(cv_rival, holdOutError(env, x.segment, fits[j], options.fit));
+    if (!cv_lin) cv_lin = holdOutError(env, x.segment, x.baseline, options.fit);
+    double cv_rival = *cv_lin;
+    if (!isAmplitudeLaw(s.added)) {
+      if (!cv_laws) {
+        double m = *cv_lin;
+        for (int j = 0; j < nc; ++j)
+          if (ok[j] && isAmplitudeLaw(steps[j].added) && steps[j].physical && steps[j].significant)
+            m = std::min(m, holdOutError(env, x.segment, fits[j], options.fit));
+        cv_laws = m;
+      }
+      cv_rival = *cv_laws;
+    }
     s.hold_out_reference = cv_rival;
     // A beat or a two-stage decay (4 parameters more than the line, a searched split) must
     // predict held-out blocks 10 % better than its rival; an amplitude law (1 more) just better.

@@ -152,6 +152,9 @@ std::vector<std::string> RingdownSegmentationOptions::validate() const {
   std::vector<std::string> p;
   if (!(floor_margin_db >= 3.0 && floor_margin_db <= 40.0))
     p.push_back("floor_margin_db must be in [3, 40] dB");
+  if (!(min_floor_margin_db >= 3.0 && min_floor_margin_db <= 40.0))
+    p.push_back("min_floor_margin_db must be in [3, 40] dB");
+  if (!(short_decay_db > 0.0)) p.push_back("short_decay_db must be > 0 dB");
   if (!(dropout_depth_db > 0.0)) p.push_back("dropout_depth_db must be > 0 dB");
   if (!(min_decay_db > 0.0)) p.push_back("min_decay_db must be > 0 dB");
   return p;
@@ -551,8 +554,8 @@ void correctWithStraightSpan(const RingdownEnvelope& env, double margin_db, Ring
         if (j < b) {
           *why << "; the decay meets a floor near " << floor_db << " dB (from "
                << env.t_s[ss.i_end - 1] << " s to " << env.t_s[b - 1] << " s the level falls at "
-               << post << " dB/s against " << ss.slope_db_s << " dB/s";
-          *why << "): the span ends " << margin_db << " dB above it at " << env.t_s[j] << " s";
+               << post << " dB/s against " << ss.slope_db_s << " dB/s): the span ends " << margin_db
+               << " dB above it at " << env.t_s[j] << " s";
           b = std::max(j, a + 9);
         }
       }

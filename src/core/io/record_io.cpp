@@ -14,6 +14,16 @@
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
+
+bool parseFiniteNumber(const std::string& s, double* value) {
+  double v = 0.0;
+  const auto res = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (s.empty() || res.ec != std::errc() || res.ptr != s.data() + s.size() || !std::isfinite(v))
+    return false;
+  *value = v;
+  return true;
+}
+
 namespace {
 
 std::string trim(const std::string& s) {
@@ -158,9 +168,7 @@ double metadataOmega(const Table& table) {
   if (it == table.metadata.end()) return 0.0;
   const std::string& s = it->second;
   double v = 0.0;
-  const auto res = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (s.empty() || res.ec != std::errc() || res.ptr != s.data() + s.size() || !std::isfinite(v) ||
-      v <= 0.0)
+  if (!parseFiniteNumber(s, &v) || v <= 0.0)
     throw InputError(table.where(table.metadata_line.at("omega")) + "# omega: '" + s +
                      "' is not a positive number [rad/s]");
   requireOmegaInRange(v, table.where(table.metadata_line.at("omega")) + "# omega");

@@ -30,6 +30,10 @@ struct RawColumnMap {
 /// unknown keys, empty names or repeated keys.
 RawColumnMap parseRawColumnMap(const std::string& spec);
 
+/// The whole of s as one finite number (no sign of trailing text, no inf/nan); false otherwise.
+/// Metadata values of `# key: value` lines are read with it.
+bool parseFiniteNumber(const std::string& s, double* value);
+
 struct RecordReadOptions {
   /// Header names of the raw record's t, f, g columns.
   RawColumnMap raw_columns;
