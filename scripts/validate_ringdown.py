@@ -157,7 +157,7 @@ gamma_nl 43100005 now called gamma_a, two_stage 43400023 now a single exponentia
 The previous reporting run (base 88412207) missed gamma_nl in 11 of 60 records, 9 of them called
 gamma_a: the fitted span skips the lock-in's settling after the drive-off, which is where a law
 in A^2 spends its extra rate (next section). The tool now estimates the detector's low-pass where
-no damping law acts, in the noise floor (src/core/estimate/ringdown_filter.cpp): for white noise
+no damping law acts, in the noise floor (src/core/single_mode/ringdown_filter.cpp): for white noise
 at the detector input the floor's power P = |z|^2 has the autocorrelation rho_n(s / T)^2 exactly
 (n equal real poles of time constant T); the empirical autocorrelation of P, from 6 dB below the
 decay's continuation to the end (120 samples or more, 8 filter lengths or more), is fitted for
@@ -179,7 +179,7 @@ The filter estimate on tuning floors (270 clean, gamma_nl and gamma_a records of
 3 in 40, 4 in 60 (the order is weakly identified by the first lags); the floor power's
 correlation time, the quantity the data fix, 1.00x the truth at the median, 10-90 % 0.72 .. 1.49.
 On this run's 360 records a filter was found in 311 (order 2 in 130, 4 in 86, 3 in 55, 1 in 40).
-Known-answer tests: test/core/estimate/ringdown_filter_test.cpp (the power correlation of 1..4
+Known-answer tests: test/core/single_mode/ringdown_filter_test.cpp (the power correlation of 1..4
 poles; T of 1- and 2-pole floors within 20 % in correlation time; the one-pole filtered decay
 against its closed form; an A^2 law fitted through the estimated filter: g0 within 10 %, g2
 within 25 %, sum of squares below the A law's).

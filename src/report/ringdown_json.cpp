@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
 
 namespace cvg_bench {
 namespace report {

@@ -1,6 +1,6 @@
 // cvg_ident identify / explain / simulate with --mode ringdown: single-channel ring-downs
 // (interfaces.md, "Single-channel ring-downs"). Reader: core/io/ringdown_record.h; segmentation and
-// fit: core/estimate/ringdown_*.h; causes: core/diagnose/ringdown_causes.h; generator:
+// fit: core/single_mode/ringdown_*.h; causes: core/single_mode/ringdown_causes.h; generator:
 // core/simulate/ringdown_simulator.h.
 #include <chrono>
 #include <cmath>
@@ -12,12 +12,12 @@
 
 #include "bag_input.h"
 #include "cli_args.h"
-#include "cvg_bench/core/diagnose/ringdown_causes.h"
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
-#include "cvg_bench/core/estimate/ringdown_span_spread.h"
 #include "cvg_bench/core/io/ringdown_record.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/ringdown_simulator.h"
+#include "cvg_bench/core/single_mode/ringdown_causes.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_span_spread.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_bench/report/ringdown_json.h"
 #include "cvg_ident_commands.h"

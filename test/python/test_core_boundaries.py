@@ -19,7 +19,7 @@ ALLOWED = {
     "simulate": {"model", "io", "simulate"},
     "demod": {"model", "io", "demod"},
     "estimate": {"model", "io", "demod", "estimate"},
-    "single_mode": {"model", "io", "estimate", "single_mode"},
+    "single_mode": {"model", "io", "demod", "estimate", "single_mode"},
     "diagnose": {"model", "io", "demod", "estimate", "diagnose"},
 }
 CORE_INCLUDE = re.compile(r'#\s*include\s*"cvg_bench/core/([a-z_]+)/(internal/)?')

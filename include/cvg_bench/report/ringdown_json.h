@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "cvg_bench/core/diagnose/ringdown_causes.h"
+#include "cvg_bench/core/single_mode/ringdown_causes.h"
 
 namespace cvg_bench {
 namespace report {

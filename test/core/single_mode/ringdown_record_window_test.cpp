@@ -1,6 +1,6 @@
 // Known-answer tests of the real-export window (ringdown_record_window.h) on envelopes shaped like
 // the development set's records: floor before the drive, switch-off steps, out-of-band drops.
-#include "cvg_bench/core/estimate/ringdown_record_window.h"
+#include "cvg_bench/core/single_mode/ringdown_record_window.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/ringdown_fit.h"
+#include "cvg_bench/core/single_mode/ringdown_fit.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -8,13 +8,13 @@
 #include <sstream>
 
 #include "cvg_bench/core/estimate/numeric_least_squares.h"
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
-#include "cvg_bench/core/estimate/ringdown_intervals.h"
-#include "cvg_bench/core/estimate/ringdown_models.h"
 #include "cvg_bench/core/estimate/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/gamma_nl_conventions.h"
 #include "cvg_bench/core/model/sample_median.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_intervals.h"
+#include "cvg_bench/core/single_mode/ringdown_models.h"
 
 namespace cvg_bench {
 namespace {

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
 
 #include <cmath>
 #include <limits>

@@ -8,7 +8,7 @@
 // widened to the within-record interval where that is wider (an open bound stays open).
 #pragma once
 
-#include "cvg_bench/core/estimate/ringdown_fit.h"
+#include "cvg_bench/core/single_mode/ringdown_fit.h"
 
 namespace cvg_bench {
 

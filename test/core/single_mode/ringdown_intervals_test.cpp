@@ -1,7 +1,7 @@
 // Known-answer tests of the ring-down interval machinery (ringdown_intervals.h): the exact AR
 // whitening of the explain criterion and the block check's coverage under noise whose correlation
 // changes along the record.
-#include "cvg_bench/core/estimate/ringdown_intervals.h"
+#include "cvg_bench/core/single_mode/ringdown_intervals.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/ringdown_span_spread.h"
+#include "cvg_bench/core/single_mode/ringdown_span_spread.h"
 
 #include <cmath>
 #include <vector>

@@ -1,5 +1,5 @@
 // Known-answer tests of the longest straight stretch (ringdown_straight_span.h).
-#include "cvg_bench/core/estimate/ringdown_straight_span.h"
+#include "cvg_bench/core/single_mode/ringdown_straight_span.h"
 
 #include <gtest/gtest.h>
 

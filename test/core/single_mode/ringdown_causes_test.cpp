@@ -1,5 +1,5 @@
 // Known-answer tests of the ring-down causes (ringdown_causes.h) on generated records.
-#include "cvg_bench/core/diagnose/ringdown_causes.h"
+#include "cvg_bench/core/single_mode/ringdown_causes.h"
 
 #include <gtest/gtest.h>
 

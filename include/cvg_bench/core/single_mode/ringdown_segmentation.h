@@ -28,7 +28,7 @@
 #include <string>
 #include <vector>
 
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
 
 namespace cvg_bench {
 

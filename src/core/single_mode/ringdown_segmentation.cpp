@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/ringdown_segmentation.h"
+#include "cvg_bench/core/single_mode/ringdown_segmentation.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -6,12 +6,12 @@
 #include <limits>
 #include <sstream>
 
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
-#include "cvg_bench/core/estimate/ringdown_models.h"
-#include "cvg_bench/core/estimate/ringdown_record_window.h"
-#include "cvg_bench/core/estimate/ringdown_straight_span.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/sample_median.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_models.h"
+#include "cvg_bench/core/single_mode/ringdown_record_window.h"
+#include "cvg_bench/core/single_mode/ringdown_straight_span.h"
 
 namespace cvg_bench {
 namespace {

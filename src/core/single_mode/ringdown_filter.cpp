@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/ringdown_filter.h"
+#include "cvg_bench/core/single_mode/ringdown_filter.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -8,10 +8,10 @@
 #include <sstream>
 
 #include "cvg_bench/core/estimate/numeric_least_squares.h"
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
-#include "cvg_bench/core/estimate/ringdown_intervals.h"
-#include "cvg_bench/core/estimate/ringdown_models.h"
 #include "cvg_bench/core/model/sample_median.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_intervals.h"
+#include "cvg_bench/core/single_mode/ringdown_models.h"
 
 namespace cvg_bench {
 namespace {

@@ -1,12 +1,12 @@
-#include "cvg_bench/core/estimate/ringdown_record_window.h"
+#include "cvg_bench/core/single_mode/ringdown_record_window.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
 
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
-#include "cvg_bench/core/estimate/ringdown_segmentation.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_segmentation.h"
 
 namespace cvg_bench {
 namespace {

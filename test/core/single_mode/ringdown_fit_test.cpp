@@ -1,14 +1,14 @@
 // Known-answer tests of the ring-down segmentation and fit on records of the ring-down generator.
-#include "cvg_bench/core/estimate/ringdown_fit.h"
+#include "cvg_bench/core/single_mode/ringdown_fit.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/ringdown_simulator.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
 
 namespace cvg_bench {
 namespace {

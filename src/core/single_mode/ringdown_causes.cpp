@@ -1,4 +1,4 @@
-#include "cvg_bench/core/diagnose/ringdown_causes.h"
+#include "cvg_bench/core/single_mode/ringdown_causes.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -8,11 +8,11 @@
 #include <optional>
 #include <sstream>
 
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
-#include "cvg_bench/core/estimate/ringdown_intervals.h"
-#include "cvg_bench/core/estimate/ringdown_models.h"
-#include "cvg_bench/core/estimate/ringdown_span_spread.h"
 #include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_intervals.h"
+#include "cvg_bench/core/single_mode/ringdown_models.h"
+#include "cvg_bench/core/single_mode/ringdown_span_spread.h"
 
 namespace cvg_bench {
 namespace {

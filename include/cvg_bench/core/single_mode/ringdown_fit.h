@@ -22,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
-#include "cvg_bench/core/estimate/ringdown_segmentation.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_segmentation.h"
 
 namespace cvg_bench {
 

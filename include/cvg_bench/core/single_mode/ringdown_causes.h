@@ -28,8 +28,8 @@
 #include <string>
 #include <vector>
 
-#include "cvg_bench/core/estimate/ringdown_filter.h"
-#include "cvg_bench/core/estimate/ringdown_fit.h"
+#include "cvg_bench/core/single_mode/ringdown_filter.h"
+#include "cvg_bench/core/single_mode/ringdown_fit.h"
 
 namespace cvg_bench {
 

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/ringdown_intervals.h"
+#include "cvg_bench/core/single_mode/ringdown_intervals.h"
 
 #include <Eigen/Dense>
 #include <boost/math/distributions/chi_squared.hpp>

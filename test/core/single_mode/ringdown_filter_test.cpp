@@ -1,6 +1,6 @@
 // Known-answer tests of the detector filter of a ring-down: its power correlation, its estimate
 // from the noise floor of a record read through a known low-pass, and the filtered envelope.
-#include "cvg_bench/core/estimate/ringdown_filter.h"
+#include "cvg_bench/core/single_mode/ringdown_filter.h"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <complex>
 #include <random>
 
-#include "cvg_bench/core/estimate/ringdown_fit.h"
-#include "cvg_bench/core/estimate/ringdown_segmentation.h"
+#include "cvg_bench/core/single_mode/ringdown_fit.h"
+#include "cvg_bench/core/single_mode/ringdown_segmentation.h"
 
 namespace cvg_bench {
 namespace {

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/ringdown_models.h"
+#include "cvg_bench/core/single_mode/ringdown_models.h"
 
 #include <boost/math/special_functions/expint.hpp>
 #include <cmath>

@@ -1,12 +1,12 @@
-#include "cvg_bench/core/estimate/ringdown_straight_span.h"
+#include "cvg_bench/core/single_mode/ringdown_straight_span.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-#include "cvg_bench/core/estimate/ringdown_envelope.h"
-#include "cvg_bench/core/estimate/ringdown_segmentation.h"
+#include "cvg_bench/core/single_mode/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_segmentation.h"
 
 namespace cvg_bench {
 namespace {
