@@ -562,6 +562,168 @@ const char* kSigmaNote =
     "sigma is the RMS misfit of the measured slow variables (units of q), not the equation units "
     "of the LS sigma-hat (2.10)";
 
+// The free-decay solve (FreeDecayRefinement's constructor) in its steps.
+
+/// Step 1: the record checked (checkTimes) and long enough for the model's k parameters and the
+/// 4 initial values.
+void checkFreeDecayRecord(const ResonatorModel& model, const SlowRecord& record) {
+  checkTimes(record);
+  const int k = model.numParameters();
+  if (4 * static_cast<int>(record.size()) <= k + 4)
+    throw InputError("free-decay record has " + std::to_string(record.size()) +
+                     " samples: too few for " + std::to_string(k) +
+                     " parameters + 4 initial values");
+}
+
+/// Step 2: unknowns scaled to O(1): z_j = z_scale_j x_j with z_scale_j = max(|start_j|, its
+/// standard error), q(t0) = q0_scale x_q with q0_scale = the record's largest |q|. z, q0: the
+/// scaled starting point.
+void scaleUnknowns(const ResonatorModel& model, const Estimate& start, const SlowRecord& record,
+                   const Eigen::VectorXd& z_start, Eigen::VectorXd* z_scale, double* q0_scale,
+                   Eigen::VectorXd* z, Eigen::Vector4d* q0) {
+  const int k = model.numParameters();
+  z_scale->resize(k);
+  for (int i = 0; i < k; ++i) {
+    const auto it = start.parameters.find(model.parameterNames()[i]);
+    const double se = it != start.parameters.end() && std::isfinite(it->second.std_error)
+                          ? it->second.std_error
+                          : 0.0;
+    (*z_scale)[i] = std::max(std::abs(z_start[i]), se);
+    if (!((*z_scale)[i] > 0)) (*z_scale)[i] = 1.0;
+  }
+  *q0_scale = 0.0;
+  for (const auto& q : record.q) *q0_scale = std::max(*q0_scale, q.norm());
+  if (!(*q0_scale > 0)) *q0_scale = 1.0;
+  *z = z_start.cwiseQuotient(*z_scale);
+  // q(t0): the start's fitted one where it has one (a nested model's refined fit), else the
+  // first measured sample.
+  const bool start_has_state =
+      start.initial_slow_state.size() == 4 && start.initial_slow_state.allFinite();
+  *q0 =
+      (start_has_state ? Eigen::Vector4d(start.initial_slow_state) : record.q.front()) / *q0_scale;
+}
+
+/// Step 3: a long record: the same problem on every s-th sample first (a start near the optimum
+/// costs the whole record a few iterations instead of tens). z, q0 move to its solution when it
+/// succeeds. Returns the note on it, empty when there was no coarse fit.
+std::string coarseStart(const ResonatorModel& model, const SlowRecord& record,
+                        const CeresOptions& options, const Eigen::VectorXd& z_start,
+                        const Eigen::VectorXd& z_scale, double q0_scale, Eigen::VectorXd* z,
+                        Eigen::Vector4d* q0) {
+  std::string coarse_note;
+  const size_t stride = coarseStride(model, z_start, record, options);
+  if (stride > 1) {
+    const SlowRecord coarse = everyNth(record, stride);
+    ceres::Problem coarse_problem;
+    Eigen::VectorXd zc = *z;
+    Eigen::Vector4d qc = *q0;
+    coarse_problem.AddResidualBlock(
+        makeFreeDecaySquareRootCost(model, coarse, options.rk4_substeps, z_scale, q0_scale)
+            .release(),
+        nullptr, zc.data(), qc.data());
+    ceres::Solver::Summary coarse_summary;
+    try {
+      solveOrThrow(&coarse_problem, options, 4 * static_cast<long>(coarse.size()), &coarse_summary);
+      *z = zc;
+      *q0 = qc;
+      coarse_note = "start from the same fit on every " + std::to_string(stride) + "th sample (" +
+                    std::to_string(coarse.size()) + " samples, " +
+                    std::to_string(coarse_summary.iterations.size() - 1) + " iterations)";
+    } catch (const AnalysisError& err) {
+      coarse_note = std::string("the fit on every ") + std::to_string(stride) +
+                    "th sample failed, started from the given estimate: " + err.what();
+    }
+  }
+  return coarse_note;
+}
+
+/// Step 4: solved in square-root form (k + 5 residuals, the per-sample rows folded as they are
+/// made). Its last pass with Jacobians (pass) is normally at the solution: rank, sigma and the
+/// residuals' lag-1 correlation come from it (else from one more pass there).
+void solveSquareRoot(const ResonatorModel& model, const SlowRecord& record,
+                     const CeresOptions& options, const Eigen::VectorXd& z_scale, double q0_scale,
+                     Eigen::VectorXd* z, Eigen::Vector4d* q0, SquareRootPass* pass,
+                     ceres::Solver::Summary* summary) {
+  const int k = model.numParameters();
+  ceres::Problem square_root;
+  auto cost =
+      makeFreeDecaySquareRootCost(model, record, options.rk4_substeps, z_scale, q0_scale, pass);
+  ceres::CostFunction* cost_ptr = cost.get();
+  square_root.AddResidualBlock(cost.release(), nullptr, z->data(), q0->data());
+  solveOrThrow(&square_root, options, 4 * static_cast<long>(record.size()), summary);
+  Eigen::VectorXd x(k + 4);
+  x << *z, *q0;
+  if (pass->x.size() != x.size() || pass->x != x) {
+    std::vector<double> residuals(k + 5), jz((k + 5) * k), jq((k + 5) * 4);
+    const double* params[2] = {z->data(), q0->data()};
+    double* jacobians[2] = {jz.data(), jq.data()};
+    if (!cost_ptr->Evaluate(params, residuals.data(), jacobians) || pass->x != x)
+      throw AnalysisError("Ceres refinement: residuals cannot be evaluated at the solution");
+  }
+}
+
+/// Step 5: the pass's triangular factor R of J with respect to the unscaled unknowns (the
+/// scaled blocks' R times the inverse scales).
+void unscaledFactor(const SquareRootPass& pass, const Eigen::VectorXd& z_scale, double q0_scale,
+                    Eigen::MatrixXd* factor) {
+  const Eigen::Index k = z_scale.size();
+  Eigen::VectorXd scale(k + 4);
+  scale << z_scale, Eigen::Vector4d::Constant(q0_scale);
+  *factor = pass.r_aug.topLeftCorner(k + 4, k + 4).triangularView<Eigen::Upper>();
+  *factor = *factor * scale.cwiseInverse().asDiagonal();
+}
+
+/// Step 6a: the solved estimate's identity and notes (the start's, then how it was refined).
+void describeFreeDecaySolve(const Estimate& start, const SlowRecord& record,
+                            const CeresOptions& options, const ResonatorModel& model,
+                            const Eigen::Vector4d& q0, double q0_scale,
+                            const std::string& coarse_note, const ceres::Solver::Summary& summary,
+                            Estimate* e) {
+  *e = start;
+  e->mode = ExperimentMode::kFreeDecay;
+  e->model = model.spec();
+  if (e->omega_rad_s <= 0) e->omega_rad_s = record.omega_rad_s;
+  e->notes.push_back(
+      "output-error refinement of the " +
+      (start.method.empty() ? std::string("given") : start.method) +
+      " estimate: averaged model (2.6) integrated by RK4 on the record's time grid (" +
+      std::to_string(options.rk4_substeps) +
+      " step(s) per sample interval), Jacobian by forward sensitivities");
+  const Eigen::Vector4d q0_fitted = q0_scale * q0;
+  e->initial_slow_state = q0_fitted;
+  e->notes.push_back("fitted initial slow variables q(t0) = " + formatQ(q0_fitted.data()) +
+                     " (4 nuisance unknowns, not in parameters)");
+  e->notes.push_back(kSigmaNote);
+  if (!coarse_note.empty()) e->notes.push_back(coarse_note);
+  e->notes.push_back(solverNote(summary));
+}
+
+/// Step 6b: without the covariance yet: values, sigma, rank and dof (as fillIntervals sets
+/// them); n residuals, ss their sum of squares, r the rank of the k + 4 unknowns.
+void setSolvedValues(const ResonatorModel& model, const CeresOptions& options, long n,
+                     const RankAnalysis& r, double ss, const Eigen::VectorXd& z,
+                     const Eigen::VectorXd& z_scale, Estimate* e) {
+  const int k = model.numParameters();
+  e->method = "ceres";
+  e->n_equations = static_cast<int>(n);
+  e->n_params = k;
+  e->rank = std::max(0, r.rank - 4);
+  e->dof = static_cast<int>(n) - r.rank;
+  e->sigma = std::sqrt(ss / e->dof);
+  e->confidence = options.confidence;
+  e->names = model.parameterNames();
+  e->values = z.cwiseProduct(z_scale);
+  e->covariance.resize(0, 0);
+  e->parameters.clear();
+  e->covariance_paper.resize(0, 0);
+  e->parameters_paper.clear();
+  e->interval_method.clear();
+  e->interval_method_id.clear();
+  e->derived.clear();
+  e->derived_method.clear();
+  e->singular_values.assign(r.s.data(), r.s.data() + r.s.size());
+}
+
 }  // namespace
 
 /// What the free-decay finish needs of the solve.
@@ -579,6 +741,7 @@ struct FreeDecayRefinement::State {
 
 FreeDecayRefinement::FreeDecayRefinement(const SlowRecord& record, const Estimate& start,
                                          const CeresOptions& options) {
+  // 1. Options, start and record checked; the model.
   requireValid(options);
   if (start.mode != ExperimentMode::kFreeDecay)
     throw InputError("refineWithCeres: start estimate is not a free-decay estimate");
@@ -588,128 +751,26 @@ FreeDecayRefinement::FreeDecayRefinement(const SlowRecord& record, const Estimat
   st->model =
       ResonatorModel(start.model.empty() ? "linear" : start.model, ExperimentMode::kFreeDecay);
   const ResonatorModel& model = st->model;
-  checkTimes(record);
-  const int k = model.numParameters();
-  if (4 * static_cast<int>(record.size()) <= k + 4)
-    throw InputError("free-decay record has " + std::to_string(record.size()) +
-                     " samples: too few for " + std::to_string(k) +
-                     " parameters + 4 initial values");
-
-  // Unknowns scaled to O(1): z_j = z_scale_j x_j with z_scale_j = max(|start_j|, its standard
-  // error), q(t0) = q0_scale x_q with q0_scale = the record's largest |q|.
+  checkFreeDecayRecord(model, record);
+  // 2. Unknowns scaled to O(1), and their starting point.
   const Eigen::VectorXd z_start = startVector(model, start);
-  Eigen::VectorXd& z_scale = st->z_scale;
-  z_scale.resize(k);
-  for (int i = 0; i < k; ++i) {
-    const auto it = start.parameters.find(model.parameterNames()[i]);
-    const double se = it != start.parameters.end() && std::isfinite(it->second.std_error)
-                          ? it->second.std_error
-                          : 0.0;
-    z_scale[i] = std::max(std::abs(z_start[i]), se);
-    if (!(z_scale[i] > 0)) z_scale[i] = 1.0;
-  }
-  double& q0_scale = st->q0_scale;
-  q0_scale = 0.0;
-  for (const auto& q : record.q) q0_scale = std::max(q0_scale, q.norm());
-  if (!(q0_scale > 0)) q0_scale = 1.0;
-  Eigen::VectorXd& z = st->z;
-  Eigen::Vector4d& q0 = st->q0;
-  z = z_start.cwiseQuotient(z_scale);
-  // q(t0): the start's fitted one where it has one (a nested model's refined fit), else the
-  // first measured sample.
-  const bool start_has_state =
-      start.initial_slow_state.size() == 4 && start.initial_slow_state.allFinite();
-  q0 = (start_has_state ? Eigen::Vector4d(start.initial_slow_state) : record.q.front()) / q0_scale;
-  // A long record: the same problem on every s-th sample first (a start near the optimum costs
-  // the whole record a few iterations instead of tens).
-  std::string coarse_note;
-  const size_t stride = coarseStride(model, z_start, record, options);
-  if (stride > 1) {
-    const SlowRecord coarse = everyNth(record, stride);
-    ceres::Problem coarse_problem;
-    Eigen::VectorXd zc = z;
-    Eigen::Vector4d qc = q0;
-    coarse_problem.AddResidualBlock(
-        makeFreeDecaySquareRootCost(model, coarse, options.rk4_substeps, z_scale, q0_scale)
-            .release(),
-        nullptr, zc.data(), qc.data());
-    ceres::Solver::Summary coarse_summary;
-    try {
-      solveOrThrow(&coarse_problem, options, 4 * static_cast<long>(coarse.size()), &coarse_summary);
-      z = zc;
-      q0 = qc;
-      coarse_note = "start from the same fit on every " + std::to_string(stride) + "th sample (" +
-                    std::to_string(coarse.size()) + " samples, " +
-                    std::to_string(coarse_summary.iterations.size() - 1) + " iterations)";
-    } catch (const AnalysisError& err) {
-      coarse_note = std::string("the fit on every ") + std::to_string(stride) +
-                    "th sample failed, started from the given estimate: " + err.what();
-    }
-  }
-  // Solved in square-root form (k + 5 residuals, the per-sample rows folded as they are made).
-  // Its last pass with Jacobians is normally at the solution: rank, sigma and the residuals'
-  // lag-1 correlation come from it (else from one more pass there).
-  ceres::Problem square_root;
-  auto cost = makeFreeDecaySquareRootCost(model, record, options.rk4_substeps, z_scale, q0_scale,
-                                          &st->pass);
-  ceres::CostFunction* cost_ptr = cost.get();
-  square_root.AddResidualBlock(cost.release(), nullptr, z.data(), q0.data());
+  scaleUnknowns(model, start, record, z_start, &st->z_scale, &st->q0_scale, &st->z, &st->q0);
+  // 3. A long record: a coarse fit first.
+  const std::string coarse_note =
+      coarseStart(model, record, options, z_start, st->z_scale, st->q0_scale, &st->z, &st->q0);
+  // 4. The whole record in square-root form.
   ceres::Solver::Summary summary;
-  solveOrThrow(&square_root, options, 4 * static_cast<long>(record.size()), &summary);
-  Eigen::VectorXd x(k + 4);
-  x << z, q0;
-  if (st->pass.x.size() != x.size() || st->pass.x != x) {
-    std::vector<double> residuals(k + 5), jz((k + 5) * k), jq((k + 5) * 4);
-    const double* params[2] = {z.data(), q0.data()};
-    double* jacobians[2] = {jz.data(), jq.data()};
-    if (!cost_ptr->Evaluate(params, residuals.data(), jacobians) || st->pass.x != x)
-      throw AnalysisError("Ceres refinement: residuals cannot be evaluated at the solution");
-  }
-  Eigen::VectorXd scale(k + 4);
-  scale << z_scale, Eigen::Vector4d::Constant(q0_scale);
-  st->factor = st->pass.r_aug.topLeftCorner(k + 4, k + 4).triangularView<Eigen::Upper>();
-  st->factor = st->factor * scale.cwiseInverse().asDiagonal();
+  solveSquareRoot(model, record, options, st->z_scale, st->q0_scale, &st->z, &st->q0, &st->pass,
+                  &summary);
+  // 5. Factor and rank at the solution.
+  unscaledFactor(st->pass, st->z_scale, st->q0_scale, &st->factor);
   const RankAnalysis r = rankFromFactor(st->factor, options.rank_tolerance);
   const long n = 4 * static_cast<long>(record.size());
   requireDegreesOfFreedom(n, r.rank);
-
-  Estimate& e = st->solved;
-  e = start;
-  e.mode = ExperimentMode::kFreeDecay;
-  e.model = model.spec();
-  if (e.omega_rad_s <= 0) e.omega_rad_s = record.omega_rad_s;
-  e.notes.push_back(
-      "output-error refinement of the " +
-      (start.method.empty() ? std::string("given") : start.method) +
-      " estimate: averaged model (2.6) integrated by RK4 on the record's time grid (" +
-      std::to_string(options.rk4_substeps) +
-      " step(s) per sample interval), Jacobian by forward sensitivities");
-  const Eigen::Vector4d q0_fitted = q0_scale * q0;
-  e.initial_slow_state = q0_fitted;
-  e.notes.push_back("fitted initial slow variables q(t0) = " + formatQ(q0_fitted.data()) +
-                    " (4 nuisance unknowns, not in parameters)");
-  e.notes.push_back(kSigmaNote);
-  if (!coarse_note.empty()) e.notes.push_back(coarse_note);
-  e.notes.push_back(solverNote(summary));
-  // Without the covariance yet: values, sigma, rank and dof (as fillIntervals sets them).
-  e.method = "ceres";
-  e.n_equations = static_cast<int>(n);
-  e.n_params = k;
-  e.rank = std::max(0, r.rank - 4);
-  e.dof = static_cast<int>(n) - r.rank;
-  e.sigma = std::sqrt(st->pass.ss / e.dof);
-  e.confidence = options.confidence;
-  e.names = model.parameterNames();
-  e.values = z.cwiseProduct(z_scale);
-  e.covariance.resize(0, 0);
-  e.parameters.clear();
-  e.covariance_paper.resize(0, 0);
-  e.parameters_paper.clear();
-  e.interval_method.clear();
-  e.interval_method_id.clear();
-  e.derived.clear();
-  e.derived_method.clear();
-  e.singular_values.assign(r.s.data(), r.s.data() + r.s.size());
+  // 6. The solved estimate (no covariance yet).
+  describeFreeDecaySolve(start, record, options, model, st->q0, st->q0_scale, coarse_note, summary,
+                         &st->solved);
+  setSolvedValues(model, options, n, r, st->pass.ss, st->z, st->z_scale, &st->solved);
   state_ = st;
 }
 
