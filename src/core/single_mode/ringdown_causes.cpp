@@ -18,6 +18,32 @@ namespace cvg_bench {
 namespace {
 
 const double kInfinity = std::numeric_limits<double>::infinity();
+/// Floor under a sum of squares or a sigma before its log or a division by it (keeps both finite).
+constexpr double kTinyPositive = 1e-300;
+/// Parameters of the single exponential (ln A0 and its rate): an extension's likelihood-ratio
+/// test has its parameters beyond these as degrees of freedom.
+constexpr int kLineParams = 2;
+/// The beat's searched split in the criterion: it pays kBeatSplitPenalty ln(max(kBeatSplitMinGrid,
+/// n / kBeatSplitGridDivisor)) on top of its parameters (ringdown_causes.h: "the beat also pays
+/// for its searched split").
+constexpr double kBeatSplitPenalty = 2.0;
+constexpr double kBeatSplitMinGrid = 2.0;      ///< see kBeatSplitPenalty
+constexpr double kBeatSplitGridDivisor = 4.0;  ///< see kBeatSplitPenalty
+/// Spread of the detector filter's time-constant estimate on simulated floors: a choice through
+/// the filter must hold at 1 / kFilterSpread, 1 and kFilterSpread times the estimate.
+constexpr double kFilterSpread = 1.4;
+/// The time-constant scales a choice through the filter must hold at (the estimate's first).
+constexpr int kFilterScaleCount = 3;
+constexpr double kFilterScales[kFilterScaleCount] = {1.0, 1.0 / kFilterSpread, kFilterSpread};
+/// "No filter scale looked at yet" for the law common to every filter scale (-1: none common).
+constexpr int kNoCommonPickYet = -2;
+/// Digits of the criteria printed in law_choice when no extension passed on the span.
+constexpr int kLawChoiceDigits = 6;
+/// Hold-out confirmation: a beat or a two-stage decay (4 parameters more than the line, a searched
+/// split) must predict held-out blocks below this fraction of its rival's error (10 % better)...
+constexpr double kHoldOutFactorExtension = 0.9;
+/// ... an amplitude law (1 parameter more) just below its rival's.
+constexpr double kHoldOutFactorLaw = 1.0;
 
 double chi2Upper(int df, double x) {
   if (!(x > 0.0)) return 1.0;
@@ -226,29 +252,39 @@ bool isAmplitudeLaw(const std::string& c) {
   return c == "gamma_nl" || c == "gamma_a";
 }
 
-}  // namespace
+/// What the steps of explainRingdown hand on to each other (one per call).
+struct ExplainState {
+  ExplainState(const RingdownEnvelope& e, const RingdownExplainOptions& o, RingdownExplanation* out)
+      : env(e),
+        options(o),
+        x(*out),
+        nc(static_cast<int>(o.candidates.size())),
+        fits(nc),
+        ok(nc, false) {}
+  const RingdownEnvelope& env;
+  const RingdownExplainOptions& options;
+  RingdownExplanation& x;
+  const int nc;                        ///< candidates tried
+  std::vector<RingdownFit> fits;       ///< per candidate
+  std::vector<bool> ok;                ///< its fit ran and has a finite weighted SSE
+  std::vector<double> ar;              ///< the common AR noise filter
+  std::vector<RingdownStep> steps;     ///< per candidate (the ok ones filled)
+  double ic_lin = 0.0;                 ///< the single exponential's criterion
+  double ic_law = kInfinity;           ///< the lowest physical amplitude law's criterion
+  double ic_negative_law = kInfinity;  ///< the lowest amplitude law's with a negative coefficient
+  std::string negative_law;            ///< that law ("" when none)
+  std::vector<bool> eligible;          ///< passed the ranking's margins
+  int best = -1;                       ///< the pick (-1: the single exponential)
+};
 
-RingdownExplanation explainRingdown(const RingdownEnvelope& env,
-                                    const RingdownExplainOptions& options) {
-  const auto problems = options.validate();
-  if (!problems.empty()) throw InputError("ring-down explain: " + problems.front());
-  RingdownExplanation x;
-  x.segment = segmentRingdown(env, options.segmentation);
-  x.baseline = fitRingdown(env, x.segment, "linear", options.fit);
-  x.final_fit = x.baseline;
-  const int nc = static_cast<int>(options.candidates.size());
-  std::vector<RingdownFit> fits(nc);
-  std::vector<bool> ok(nc, false);
-  // Likelihood under a common AR noise model (generalized least squares): the AR filter of the
-  // best-fitting model's residuals (those closest to the noise) whitens every model's weighted
-  // residuals, and the criterion is BIC on the whitened sum of squares, so that correlated noise
-  // neither counts as independent samples nor hides structure at the beat frequencies.
-  const RingdownFit* closest = &x.baseline;
-  for (int k = 0; k < nc; ++k) {
-    const std::string& c = options.candidates[k];
+/// 1. Every candidate fitted, started from the single exponential; a failed fit is a step at once.
+void fitCandidates(ExplainState& st) {
+  RingdownExplanation& x = st.x;
+  for (int k = 0; k < st.nc; ++k) {
+    const std::string& c = st.options.candidates[k];
     try {
-      fits[k] = fitRingdown(env, x.segment, c, options.fit, ringdownStarts(c, x.baseline));
-      ok[k] = std::isfinite(fits[k].sse_w);
+      st.fits[k] = fitRingdown(st.env, x.segment, c, st.options.fit, ringdownStarts(c, x.baseline));
+      st.ok[k] = std::isfinite(st.fits[k].sse_w);
     } catch (const AnalysisError& e) {
       RingdownStep s;
       s.added = c;
@@ -257,234 +293,293 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
       continue;
     }
   }
-  for (int k = 0; k < nc; ++k)
-    if (ok[k] && fits[k].sse_w < closest->sse_w) closest = &fits[k];
-  const std::vector<double> ar = closest->noise_ar;
-  auto whitenedSse = [&ar](const RingdownFit& f) {
-    const size_t m = f.t_s.size();
-    std::vector<double> e(m);
-    for (size_t i = 0; i < m; ++i)
-      e[i] = std::sqrt(f.weight[i]) * (f.log_amplitude[i] - f.fitted[i]);
-    double sse = 0.0;
-    for (double w : ringdownArWhiten(ar, e)) sse += w * w;
-    return sse;
-  };
+}
+
+/// 2. Likelihood under a common AR noise model (generalized least squares): the AR filter of the
+/// best-fitting model's residuals (those closest to the noise; the single exponential's or a
+/// fitted candidate's) whitens every model's weighted residuals, and the criterion is BIC on the
+/// whitened sum of squares, so that correlated noise neither counts as independent samples nor
+/// hides structure at the beat frequencies.
+std::vector<double> commonNoiseAr(const ExplainState& st) {
+  const RingdownFit* closest = &st.x.baseline;
+  for (int k = 0; k < st.nc; ++k)
+    if (st.ok[k] && st.fits[k].sse_w < closest->sse_w) closest = &st.fits[k];
+  return closest->noise_ar;
+}
+
+/// A fit's weighted residuals through the AR filter `ar`: their sum of squares.
+double whitenedSse(const std::vector<double>& ar, const RingdownFit& f) {
+  const size_t m = f.t_s.size();
+  std::vector<double> e(m);
+  for (size_t i = 0; i < m; ++i) e[i] = std::sqrt(f.weight[i]) * (f.log_amplitude[i] - f.fitted[i]);
+  double sse = 0.0;
+  for (double w : ringdownArWhiten(ar, e)) sse += w * w;
+  return sse;
+}
+
+/// BIC of a fit on the whitened sum of squares over n samples; the beat also pays for its
+/// searched split.
+double informationCriterion(const std::vector<double>& ar, double n, const RingdownFit& f) {
+  double pen = f.n_params * std::log(n);
+  if (f.model == "beat")
+    pen += kBeatSplitPenalty * std::log(std::max(kBeatSplitMinGrid, n / kBeatSplitGridDivisor));
+  return n * std::log(std::max(whitenedSse(ar, f), kTinyPositive) / n) + pen;
+}
+
+/// 3. Each fitted candidate's step: criterion, likelihood ratio, sign check, effect size; the
+/// lowest physical amplitude law and the lowest one with a negative coefficient.
+void scoreCandidates(ExplainState& st) {
+  RingdownExplanation& x = st.x;
+  const RingdownExplainOptions& options = st.options;
   const double n = static_cast<double>(x.baseline.n);
   const double n_eff = n;
-  auto ic = [&](const RingdownFit& f) {
-    double pen = f.n_params * std::log(n);
-    if (f.model == "beat") pen += 2.0 * std::log(std::max(2.0, n / 4.0));
-    return n * std::log(std::max(whitenedSse(f), 1e-300) / n) + pen;
-  };
-  const double ic_lin = ic(x.baseline);
-  x.information_criterion["linear"] = ic_lin;
-  std::vector<RingdownStep> steps(nc);
-  double ic_law = kInfinity, ic_negative_law = kInfinity;
-  std::string negative_law;
-  for (int k = 0; k < nc; ++k) {
-    if (!ok[k]) continue;
-    const RingdownFit& f = fits[k];
-    RingdownStep& s = steps[k];
+  st.ic_lin = informationCriterion(st.ar, n, x.baseline);
+  x.information_criterion["linear"] = st.ic_lin;
+  st.steps.resize(st.nc);
+  for (int k = 0; k < st.nc; ++k) {
+    if (!st.ok[k]) continue;
+    const RingdownFit& f = st.fits[k];
+    RingdownStep& s = st.steps[k];
     s.added = options.candidates[k];
     s.n_eff = n_eff;
     s.sigma = f.sigma;
-    s.sigma_ratio = x.baseline.sigma / std::max(f.sigma, 1e-300);
-    s.lr_statistic =
-        n * std::log(std::max(whitenedSse(x.baseline), 1e-300) / std::max(whitenedSse(f), 1e-300));
-    s.information_criterion = ic(f);
-    s.threshold = s.information_criterion - ic_lin + s.lr_statistic + options.margin;
-    s.p_value = chi2Upper(f.n_params - 2, s.lr_statistic);
-    s.significant = ic_lin - s.information_criterion > options.margin;
+    s.sigma_ratio = x.baseline.sigma / std::max(f.sigma, kTinyPositive);
+    s.lr_statistic = n * std::log(std::max(whitenedSse(st.ar, x.baseline), kTinyPositive) /
+                                  std::max(whitenedSse(st.ar, f), kTinyPositive));
+    s.information_criterion = informationCriterion(st.ar, n, f);
+    s.threshold = s.information_criterion - st.ic_lin + s.lr_statistic + options.margin;
+    s.p_value = chi2Upper(f.n_params - kLineParams, s.lr_statistic);
+    s.significant = st.ic_lin - s.information_criterion > options.margin;
     s.note = signCheck(f);
     s.physical = s.note.empty();
     if (f.fitted.size() == x.baseline.fitted.size()) {
       for (size_t i = 0; i < f.fitted.size(); ++i)
         s.effect_db = std::max(s.effect_db, std::fabs(f.fitted[i] - x.baseline.fitted[i]));
       s.effect_db *= kDbPerNeper;
-      s.effect_over_rms = s.effect_db / std::max(x.baseline.rms_log * kDbPerNeper, 1e-300);
+      s.effect_over_rms = s.effect_db / std::max(x.baseline.rms_log * kDbPerNeper, kTinyPositive);
     }
     x.information_criterion[s.added] = s.information_criterion;
     if (isAmplitudeLaw(s.added)) {
       if (s.physical)
-        ic_law = std::min(ic_law, s.information_criterion);
-      else if (f.p(2) < 0.0 && s.information_criterion < ic_negative_law)
-        ic_negative_law = s.information_criterion, negative_law = s.added;
+        st.ic_law = std::min(st.ic_law, s.information_criterion);
+      else if (f.p(2) < 0.0 && s.information_criterion < st.ic_negative_law)
+        st.ic_negative_law = s.information_criterion, st.negative_law = s.added;
     }
   }
-  // Ranking: a beat or a two-stage decay must beat every physical amplitude law by the margin
-  // beyond its extra parameters; then the lowest criterion among the significant physical ones.
-  int best = -1;
-  std::vector<bool> eligible(nc, false);
-  for (int k = 0; k < nc; ++k) {
-    RingdownStep& s = steps[k];
-    if (!ok[k]) continue;
+}
+
+/// 4. Ranking: a beat or a two-stage decay must beat every physical amplitude law by the margin
+/// beyond its extra parameters; then the lowest criterion among the significant physical ones.
+void rankCandidates(ExplainState& st) {
+  st.best = -1;
+  st.eligible.assign(st.nc, false);
+  for (int k = 0; k < st.nc; ++k) {
+    RingdownStep& s = st.steps[k];
+    if (!st.ok[k]) continue;
     if (!s.significant || !s.physical) {
       if (s.note.empty()) s.note = "criterion not below the single exponential's by the margin";
       continue;
     }
-    if (!isAmplitudeLaw(s.added) && ic_law - s.information_criterion < options.law_margin) {
+    if (!isAmplitudeLaw(s.added) && st.ic_law - s.information_criterion < st.options.law_margin) {
       s.note = "does not beat the amplitude-dependent damping laws by the margin";
       continue;
     }
-    eligible[k] = true;
-    if (best < 0 || s.information_criterion < steps[best].information_criterion) best = k;
+    st.eligible[k] = true;
+    if (st.best < 0 || s.information_criterion < st.steps[st.best].information_criterion)
+      st.best = k;
   }
-  // The detector's filter from the floor, and the choice between the two amplitude laws re-made
-  // through it from the plateau on (ringdown_filter.h): the span skips the filter's settling, which
-  // is where a law in A^2 spends its extra rate. A filter taken too slow makes the corner rounder
-  // than it is and favours the law with more early rate (and the reverse), so a choice through the
-  // filter counts only when it holds with the time constant at 1 / kFilterSpread, 1 and
-  // kFilterSpread times its estimate (the estimate's spread on simulated floors).
-  x.detector_filter =
-      estimateDetectorFilter(env, x.segment, x.baseline.p(1) / x.baseline.t_scale_s);
-  const double kFilterSpread = 1.4;
-  auto scaledFilter = [&](double s) {
-    RingdownDetectorFilter f = x.detector_filter;
-    f.time_constant_s *= s;
-    return f;
-  };
-  const double kScales[3] = {1.0, 1.0 / kFilterSpread, kFilterSpread};
-  auto icf = [](const RingdownFilteredFit& f) {
-    return f.n * std::log(std::max(f.sse_whitened, 1e-300) / f.n) +
-           static_cast<double>(f.p.size()) * std::log(static_cast<double>(f.n));
-  };
-  auto physical = [](const RingdownFilteredFit& f) { return f.ok && f.p(1) > 0.0 && f.p(2) > 0.0; };
-  if (best >= 0 && isAmplitudeLaw(steps[best].added)) {
-    int rival = -1;
-    for (int k = 0; k < nc; ++k)
-      if (k != best && ok[k] && isAmplitudeLaw(steps[k].added) && steps[k].physical &&
-          steps[k].significant)
-        rival = k;
-    if (rival < 0) {
-      x.law_choice = "the other amplitude law does not pass: no second comparison";
-    } else if (!x.detector_filter.found) {
-      x.law_choice = "no detector filter estimated: the laws compared on the span alone";
-    } else {
-      std::ostringstream w;
-      w << "through the detector filter (T x 1, 1/" << kFilterSpread << ", " << kFilterSpread
-        << "):";
-      int votes = 0;
-      for (double sc : kScales) {
-        const RingdownDetectorFilter filt = scaledFilter(sc);
-        const RingdownFilteredFit fb =
-            fitRingdownThroughFilter(env, x.segment, fits[best], filt, ar);
-        const RingdownFilteredFit fr =
-            fitRingdownThroughFilter(env, x.segment, fits[rival], filt, ar);
-        const bool pb = physical(fb), pr = physical(fr);
-        if (sc == 1.0) {
-          if (fb.ok) x.law_choice_sse[fb.model] = fb.sse_whitened;
-          if (fr.ok) x.law_choice_sse[fr.model] = fr.sse_whitened;
-          w << " from " << fmt(fb.t_start_s) << " s (drive-off fitted at " << fmt(fb.drive_off_s)
-            << " s, " << fb.n << " samples)";
-        }
-        const bool flip = pr && (!pb || fr.sse_whitened < fb.sse_whitened);
-        votes += flip;
-        w << "; AR-whitened SSE " << fb.model << " " << (fb.ok ? fmt(fb.sse_whitened) : "n/a")
-          << (pb ? "" : " (negative damping)") << ", " << fr.model << " "
-          << (fr.ok ? fmt(fr.sse_whitened) : "n/a") << (pr ? "" : " (negative damping)");
-      }
-      w << " -> " << (votes == 3 ? steps[rival].added : steps[best].added)
-        << (votes == 3 ? " at every filter" : " (the span's choice; a change needs every filter)");
-      if (votes == 3) best = rival;
-      x.law_choice = w.str();
-    }
-  } else if (best < 0 && x.detector_filter.found) {
-    // No extension on the span: the amplitude laws against the single exponential once more
-    // through the filter from the plateau on (the same criterion and margin on those samples), at
-    // each of the three filters; a law is added when the same one wins at all three.
+}
+
+/// The detector filter with its time constant times s.
+RingdownDetectorFilter scaledFilter(const RingdownDetectorFilter& estimate, double s) {
+  RingdownDetectorFilter f = estimate;
+  f.time_constant_s *= s;
+  return f;
+}
+
+/// BIC of a fit through the filter, on its AR-whitened sum of squares.
+double filteredCriterion(const RingdownFilteredFit& f) {
+  return f.n * std::log(std::max(f.sse_whitened, kTinyPositive) / f.n) +
+         static_cast<double>(f.p.size()) * std::log(static_cast<double>(f.n));
+}
+
+/// A fit through the filter with both dampings positive.
+bool filteredPhysical(const RingdownFilteredFit& f) {
+  return f.ok && f.p(1) > 0.0 && f.p(2) > 0.0;
+}
+
+/// 5a. The pick is an amplitude law: the other law, when it passes too, against it through the
+/// filter at each of the three time constants; the other is taken when it wins at all three.
+void compareLawsThroughFilter(ExplainState& st) {
+  RingdownExplanation& x = st.x;
+  const int best = st.best;
+  int rival = -1;
+  for (int k = 0; k < st.nc; ++k)
+    if (k != best && st.ok[k] && isAmplitudeLaw(st.steps[k].added) && st.steps[k].physical &&
+        st.steps[k].significant)
+      rival = k;
+  if (rival < 0) {
+    x.law_choice = "the other amplitude law does not pass: no second comparison";
+  } else if (!x.detector_filter.found) {
+    x.law_choice = "no detector filter estimated: the laws compared on the span alone";
+  } else {
     std::ostringstream w;
-    w.precision(6);
-    w << "no extension on the span; through the detector filter (T x 1, 1/" << kFilterSpread << ", "
-      << kFilterSpread << ") from the plateau on, criteria:";
-    int common = -2;
-    for (double sc : kScales) {
-      const RingdownDetectorFilter filt = scaledFilter(sc);
-      const RingdownFilteredFit fl = fitRingdownThroughFilter(env, x.segment, x.baseline, filt, ar);
-      int pick = -1;
-      if (fl.ok) {
-        if (sc == 1.0) x.law_choice_sse["linear"] = fl.sse_whitened;
-        w << (sc == 1.0 ? " " : "; ") << "linear " << icf(fl);
-        double ic_pick = icf(fl) - options.margin;
-        for (int k = 0; k < nc; ++k) {
-          if (!ok[k] || !isAmplitudeLaw(steps[k].added) || !steps[k].physical) continue;
-          const RingdownFilteredFit f = fitRingdownThroughFilter(env, x.segment, fits[k], filt, ar);
-          if (!f.ok || f.n != fl.n) continue;
-          if (sc == 1.0) x.law_choice_sse[f.model] = f.sse_whitened;
-          w << ", " << f.model << " " << icf(f) << (physical(f) ? "" : " (negative damping)");
-          if (physical(f) && icf(f) < ic_pick) ic_pick = icf(f), pick = k;
-        }
+    w << "through the detector filter (T x 1, 1/" << kFilterSpread << ", " << kFilterSpread << "):";
+    int votes = 0;
+    for (double sc : kFilterScales) {
+      const RingdownDetectorFilter filt = scaledFilter(x.detector_filter, sc);
+      const RingdownFilteredFit fb =
+          fitRingdownThroughFilter(st.env, x.segment, st.fits[best], filt, st.ar);
+      const RingdownFilteredFit fr =
+          fitRingdownThroughFilter(st.env, x.segment, st.fits[rival], filt, st.ar);
+      const bool pb = filteredPhysical(fb), pr = filteredPhysical(fr);
+      if (sc == 1.0) {
+        if (fb.ok) x.law_choice_sse[fb.model] = fb.sse_whitened;
+        if (fr.ok) x.law_choice_sse[fr.model] = fr.sse_whitened;
+        w << " from " << fmt(fb.t_start_s) << " s (drive-off fitted at " << fmt(fb.drive_off_s)
+          << " s, " << fb.n << " samples)";
       }
-      common = common == -2 || common == pick ? pick : -1;
+      const bool flip = pr && (!pb || fr.sse_whitened < fb.sse_whitened);
+      votes += flip;
+      w << "; AR-whitened SSE " << fb.model << " " << (fb.ok ? fmt(fb.sse_whitened) : "n/a")
+        << (pb ? "" : " (negative damping)") << ", " << fr.model << " "
+        << (fr.ok ? fmt(fr.sse_whitened) : "n/a") << (pr ? "" : " (negative damping)");
     }
-    if (common >= 0) {
-      best = common;
-      steps[common].note =
-          "criterion below the single exponential's by the margin through the detector filter "
-          "(from the plateau on, at each of the three filters)";
-    }
-    w << " -> " << (common >= 0 ? steps[common].added : std::string("linear"));
+    w << " -> " << (votes == kFilterScaleCount ? st.steps[rival].added : st.steps[best].added)
+      << (votes == kFilterScaleCount ? " at every filter"
+                                     : " (the span's choice; a change needs every filter)");
+    if (votes == kFilterScaleCount) st.best = rival;
     x.law_choice = w.str();
   }
-  // Hold-out confirmation against the single exponential (and, for a beat or a two-stage decay,
-  // against the best physical amplitude law); then, for a beat or a two-stage decay, its Q within
-  // q_factor of the single exponential's over the same span: one that lies further describes
-  // something else than the decay a person reads off the record (on the real development set: a
-  // switch-off transient taken for a fast beating mode, a floor taken for a slow second stage);
-  // the generator's true beats and two-stage decays stay within it (tuning base 41000000: 29 of 30
-  // each). The amplitude laws report Q at zero amplitude, which differs from the line's by design.
-  // The rivals' hold-out errors are the same for every candidate tried: computed once, on demand.
+}
+
+/// 5b. No extension on the span: the amplitude laws against the single exponential once more
+/// through the filter from the plateau on (the same criterion and margin on those samples), at
+/// each of the three filters; a law is added when the same one wins at all three.
+void addLawThroughFilter(ExplainState& st) {
+  RingdownExplanation& x = st.x;
+  std::ostringstream w;
+  w.precision(kLawChoiceDigits);
+  w << "no extension on the span; through the detector filter (T x 1, 1/" << kFilterSpread << ", "
+    << kFilterSpread << ") from the plateau on, criteria:";
+  int common = kNoCommonPickYet;
+  for (double sc : kFilterScales) {
+    const RingdownDetectorFilter filt = scaledFilter(x.detector_filter, sc);
+    const RingdownFilteredFit fl =
+        fitRingdownThroughFilter(st.env, x.segment, x.baseline, filt, st.ar);
+    int pick = -1;
+    if (fl.ok) {
+      if (sc == 1.0) x.law_choice_sse["linear"] = fl.sse_whitened;
+      w << (sc == 1.0 ? " " : "; ") << "linear " << filteredCriterion(fl);
+      double ic_pick = filteredCriterion(fl) - st.options.margin;
+      for (int k = 0; k < st.nc; ++k) {
+        if (!st.ok[k] || !isAmplitudeLaw(st.steps[k].added) || !st.steps[k].physical) continue;
+        const RingdownFilteredFit f =
+            fitRingdownThroughFilter(st.env, x.segment, st.fits[k], filt, st.ar);
+        if (!f.ok || f.n != fl.n) continue;
+        if (sc == 1.0) x.law_choice_sse[f.model] = f.sse_whitened;
+        w << ", " << f.model << " " << filteredCriterion(f)
+          << (filteredPhysical(f) ? "" : " (negative damping)");
+        if (filteredPhysical(f) && filteredCriterion(f) < ic_pick)
+          ic_pick = filteredCriterion(f), pick = k;
+      }
+    }
+    common = common == kNoCommonPickYet || common == pick ? pick : -1;
+  }
+  if (common >= 0) {
+    st.best = common;
+    st.steps[common].note =
+        "criterion below the single exponential's by the margin through the detector filter "
+        "(from the plateau on, at each of the three filters)";
+  }
+  w << " -> " << (common >= 0 ? st.steps[common].added : std::string("linear"));
+  x.law_choice = w.str();
+}
+
+/// 5. The detector's filter from the floor, and the choice between the two amplitude laws re-made
+/// through it from the plateau on (ringdown_filter.h): the span skips the filter's settling, which
+/// is where a law in A^2 spends its extra rate. A filter taken too slow makes the corner rounder
+/// than it is and favours the law with more early rate (and the reverse), so a choice through the
+/// filter counts only when it holds with the time constant at 1 / kFilterSpread, 1 and
+/// kFilterSpread times its estimate (the estimate's spread on simulated floors).
+void chooseLawThroughFilter(ExplainState& st) {
+  RingdownExplanation& x = st.x;
+  x.detector_filter =
+      estimateDetectorFilter(st.env, x.segment, x.baseline.p(1) / x.baseline.t_scale_s);
+  if (st.best >= 0 && isAmplitudeLaw(st.steps[st.best].added))
+    compareLawsThroughFilter(st);
+  else if (st.best < 0 && x.detector_filter.found)
+    addLawThroughFilter(st);
+}
+
+/// The rivals' hold-out errors are the same for every candidate tried: computed once, on demand.
+struct HoldOutRivals {
   std::optional<double> cv_lin, cv_laws;
-  auto confirmCandidate = [&](int k) {
-    RingdownStep& s = steps[k];
-    s.hold_out_error = holdOutError(env, x.segment, fits[k], options.fit);
-    if (!cv_lin) cv_lin = holdOutError(env, x.segment, x.baseline, options.fit);
-    double cv_rival = *cv_lin;
-    if (!isAmplitudeLaw(s.added)) {
-      if (!cv_laws) {
-        double m = *cv_lin;
-        for (int j = 0; j < nc; ++j)
-          if (ok[j] && isAmplitudeLaw(steps[j].added) && steps[j].physical && steps[j].significant)
-            m = std::min(m, holdOutError(env, x.segment, fits[j], options.fit));
-        cv_laws = m;
+};
+
+/// Hold-out confirmation against the single exponential (and, for a beat or a two-stage decay,
+/// against the best physical amplitude law); then, for a beat or a two-stage decay, its Q within
+/// q_factor of the single exponential's over the same span: one that lies further describes
+/// something else than the decay a person reads off the record (on the real development set: a
+/// switch-off transient taken for a fast beating mode, a floor taken for a slow second stage);
+/// the generator's true beats and two-stage decays stay within it (tuning base 41000000: 29 of 30
+/// each). The amplitude laws report Q at zero amplitude, which differs from the line's by design.
+bool confirmCandidate(ExplainState& st, HoldOutRivals* rivals, int k) {
+  RingdownExplanation& x = st.x;
+  const RingdownExplainOptions& options = st.options;
+  std::optional<double>& cv_lin = rivals->cv_lin;
+  std::optional<double>& cv_laws = rivals->cv_laws;
+  RingdownStep& s = st.steps[k];
+  s.hold_out_error = holdOutError(st.env, x.segment, st.fits[k], options.fit);
+  if (!cv_lin) cv_lin = holdOutError(st.env, x.segment, x.baseline, options.fit);
+  double cv_rival = *cv_lin;
+  if (!isAmplitudeLaw(s.added)) {
+    if (!cv_laws) {
+      double m = *cv_lin;
+      for (int j = 0; j < st.nc; ++j)
+        if (st.ok[j] && isAmplitudeLaw(st.steps[j].added) && st.steps[j].physical &&
+            st.steps[j].significant)
+          m = std::min(m, holdOutError(st.env, x.segment, st.fits[j], options.fit));
+      cv_laws = m;
+    }
+    cv_rival = *cv_laws;
+  }
+  s.hold_out_reference = cv_rival;
+  // A beat or a two-stage decay (4 parameters more than the line, a searched split) must
+  // predict held-out blocks 10 % better than its rival; an amplitude law (1 more) just better.
+  const double factor = isAmplitudeLaw(s.added) ? kHoldOutFactorLaw : kHoldOutFactorExtension;
+  if (!(s.hold_out_error < factor * cv_rival)) {
+    s.note = "not confirmed on hold-out (blocked two-fold prediction error " +
+             fmt(s.hold_out_error) + " vs " + fmt(cv_rival) + ")";
+    return false;
+  }
+  if (!isAmplitudeLaw(s.added)) {
+    const auto qe = st.fits[k].derived.find("Q"), ql = x.baseline.derived.find("Q");
+    if (qe != st.fits[k].derived.end() && ql != x.baseline.derived.end()) {
+      const double ratio = qe->second.value / ql->second.value;
+      if (!(ratio < options.q_factor && ratio > 1.0 / options.q_factor)) {
+        s.note = "Q " + fmt(qe->second.value) + " against the single exponential's " +
+                 fmt(ql->second.value) + " over the same span (a factor over " +
+                 fmt(options.q_factor) + "): not the decay read off the record";
+        return false;
       }
-      cv_rival = *cv_laws;
     }
-    s.hold_out_reference = cv_rival;
-    // A beat or a two-stage decay (4 parameters more than the line, a searched split) must
-    // predict held-out blocks 10 % better than its rival; an amplitude law (1 more) just better.
-    const double factor = isAmplitudeLaw(s.added) ? 1.0 : 0.9;
-    if (!(s.hold_out_error < factor * cv_rival)) {
-      s.note = "not confirmed on hold-out (blocked two-fold prediction error " +
-               fmt(s.hold_out_error) + " vs " + fmt(cv_rival) + ")";
-      return false;
-    }
-    if (!isAmplitudeLaw(s.added)) {
-      const auto qe = fits[k].derived.find("Q"), ql = x.baseline.derived.find("Q");
-      if (qe != fits[k].derived.end() && ql != x.baseline.derived.end()) {
-        const double ratio = qe->second.value / ql->second.value;
-        if (!(ratio < options.q_factor && ratio > 1.0 / options.q_factor)) {
-          s.note = "Q " + fmt(qe->second.value) + " against the single exponential's " +
-                   fmt(ql->second.value) + " over the same span (a factor over " +
-                   fmt(options.q_factor) + "): not the decay read off the record";
-          return false;
-        }
-      }
-    }
-    s.accepted = true;
-    return true;
-  };
-  // Confirmation: the pick and, when it is a beat or a two-stage decay, the other of those two
-  // when eligible, in the order of their criterion, until one passes both checks above (a beat
-  // rejected as a switch-off transient leaves the two-stage decay that describes the same record
-  // its turn; D060 of the development set). The amplitude laws get no second turn: a beat or
-  // two-stage decay is eligible only when it beat them by law_margin (letting them in after it
-  // named gamma laws on 6 of the development set's clean tuning records).
+  }
+  s.accepted = true;
+  return true;
+}
+
+/// The candidates confirmation tries: the pick and, when it is a beat or a two-stage decay, the
+/// other of those two when eligible, in the order of their criterion (see confirmPick).
+std::vector<int> confirmationOrder(const ExplainState& st) {
+  const int best = st.best;
+  const std::vector<RingdownStep>& steps = st.steps;
   std::vector<int> order;
   if (best >= 0) order.push_back(best);
   {
     std::vector<int> rest;
-    for (int k = 0; k < nc; ++k)
-      if (k != best && eligible[k] && !isAmplitudeLaw(steps[k].added) && best >= 0 &&
+    for (int k = 0; k < st.nc; ++k)
+      if (k != best && st.eligible[k] && !isAmplitudeLaw(steps[k].added) && best >= 0 &&
           !isAmplitudeLaw(steps[best].added))
         rest.push_back(k);
     std::sort(rest.begin(), rest.end(), [&](int a, int b) {
@@ -492,45 +587,78 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
     });
     if (best >= 0) order.insert(order.end(), rest.begin(), rest.end());
   }
-  best = -1;
+  return order;
+}
+
+/// 6. Confirmation: the pick and, when it is a beat or a two-stage decay, the other of those two
+/// when eligible, in the order of their criterion, until one passes both checks of
+/// confirmCandidate (a beat rejected as a switch-off transient leaves the two-stage decay that
+/// describes the same record its turn; D060 of the development set). The amplitude laws get no
+/// second turn: a beat or two-stage decay is eligible only when it beat them by law_margin
+/// (letting them in after it named gamma laws on 6 of the development set's clean tuning records).
+void confirmPick(ExplainState& st) {
+  const std::vector<int> order = confirmationOrder(st);
+  HoldOutRivals rivals;
+  st.best = -1;
   for (const int k : order) {
-    if (confirmCandidate(k)) {
-      best = k;
+    if (confirmCandidate(st, &rivals, k)) {
+      st.best = k;
       break;
     }
   }
+}
+
+/// 7. The steps into the explanation, with why the eligible ones not taken were not; the pick
+/// into the final fit. Returns the accepted step (nullptr: none).
+const RingdownStep* recordSteps(ExplainState& st) {
+  RingdownExplanation& x = st.x;
+  const int best = st.best;
+  std::vector<RingdownStep>& steps = st.steps;
   // Eligible candidates never tried, or tried after the pick: say why they were not selected.
-  for (int k = 0; k < nc; ++k)
-    if (ok[k] && eligible[k] && k != best && steps[k].note.empty())
+  for (int k = 0; k < st.nc; ++k)
+    if (st.ok[k] && st.eligible[k] && k != best && steps[k].note.empty())
       steps[k].note = "criterion above " + (best >= 0 ? steps[best].added + "'s (selected)"
                                                       : std::string("a candidate tried first"));
-  for (int k = 0; k < nc; ++k)
-    if (ok[k]) x.steps.push_back(steps[k]);
+  for (int k = 0; k < st.nc; ++k)
+    if (st.ok[k]) x.steps.push_back(steps[k]);
   const RingdownStep* pick = nullptr;
   if (best >= 0) {
     x.selected.push_back(steps[best].added);
-    x.final_fit = fits[best];
+    x.final_fit = st.fits[best];
     for (const auto& s : x.steps)
       if (s.accepted) pick = &s;
   }
-  // An amplitude law that fits only with a negative coefficient and beats every physical
-  // candidate: the decay accelerates as it falls (no damping law does that).
-  double ic_best_physical = ic_lin;
-  for (int k = 0; k < nc; ++k)
-    if (ok[k] && steps[k].physical)
-      ic_best_physical = std::min(ic_best_physical, steps[k].information_criterion);
-  if (!(ic_best_physical - ic_negative_law > options.margin)) negative_law.clear();
+  return pick;
+}
+
+/// 8. An amplitude law that fits only with a negative coefficient and beats every physical
+/// candidate: the decay accelerates as it falls (no damping law does that).
+void screenNegativeLaw(ExplainState& st) {
+  RingdownExplanation& x = st.x;
+  double ic_best_physical = st.ic_lin;
+  for (int k = 0; k < st.nc; ++k)
+    if (st.ok[k] && st.steps[k].physical)
+      ic_best_physical = std::min(ic_best_physical, st.steps[k].information_criterion);
+  if (!(ic_best_physical - st.ic_negative_law > st.options.margin)) st.negative_law.clear();
   // ... and only when the acceleration is large enough to see (the lack of fit's size rule).
-  for (int k = 0; k < nc && !negative_law.empty(); ++k) {
-    if (!ok[k] || steps[k].added != negative_law) continue;
-    std::vector<double> d(fits[k].fitted.size());
+  for (int k = 0; k < st.nc && !st.negative_law.empty(); ++k) {
+    if (!st.ok[k] || st.steps[k].added != st.negative_law) continue;
+    std::vector<double> d(st.fits[k].fitted.size());
     if (d.size() != x.baseline.fitted.size()) break;
-    for (size_t i = 0; i < d.size(); ++i) d[i] = fits[k].fitted[i] - x.baseline.fitted[i];
-    x.negative_law_rate_variation = curveRateVariation(fits[k].t_s, d, meanDecayRate(x.baseline));
-    if (!(x.negative_law_rate_variation > options.rate_variation)) negative_law.clear();
+    for (size_t i = 0; i < d.size(); ++i) d[i] = st.fits[k].fitted[i] - x.baseline.fitted[i];
+    x.negative_law_rate_variation =
+        curveRateVariation(st.fits[k].t_s, d, meanDecayRate(x.baseline));
+    if (!(x.negative_law_rate_variation > st.options.rate_variation)) st.negative_law.clear();
   }
+}
+
+/// 9. The final fit's Q and spread checked, its lack of fit, and the verdicts unexplained and
+/// adequate. Returns whether a fitted damping is negative.
+bool judgeFinalFit(ExplainState& st, const RingdownStep* pick) {
+  RingdownExplanation& x = st.x;
+  const RingdownExplainOptions& options = st.options;
   requirePositiveQ(x.final_fit, x.segment);
-  addSpanSpread(env, x.segment, options.fit, &x.final_fit);
+  addSpanSpread(st.env, x.segment, options.fit, &x.final_fit);
   const RingdownLackOfFit lack = ringdownLackOfFit(x.final_fit);
   x.lack_of_fit_p = lack.p_value;
   x.lack_of_fit_rate_variation = lack.rate_variation;
@@ -543,20 +671,51 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
   // records: a floor that breathes under the decay, a detector not quite log-linear).
   const bool lof =
       x.lack_of_fit_p < options.alpha && x.lack_of_fit_rate_variation > options.rate_variation;
-  x.unexplained = lof || (!pick && !negative_law.empty());
+  x.unexplained = lof || (!pick && !st.negative_law.empty());
   bool negative = false;
   for (const auto& fl : x.final_fit.flags) negative |= fl.rfind("negative", 0) == 0;
   x.adequate = !x.unexplained && !negative;
-  const RingdownStep* best_step = pick;
-  // Causes and the sentence.
+  return negative;
+}
+
+/// A derived quantity of the final fit with its interval, as the sentence prints it.
+std::string qText(const RingdownFit& fin, const std::string& k) {
+  const auto it = fin.derived.find(k);
+  if (it == fin.derived.end()) return std::string("n/a (no frequency)");
+  return fmt(it->second.value) + " [" + fmt(it->second.ci_low) + ", " + fmt(it->second.ci_high) +
+         "]";
+}
+
+/// The sentence of an accepted extension `added` with the final fit `fin`.
+void describeExtension(std::ostringstream& cs, const std::string& added, const RingdownFit& fin) {
+  if (added == "gamma_nl")
+    cs << "Damping grows with the amplitude squared (gas or thermoelastic-like loss): Q0 = "
+       << qText(fin, "Q0") << " at zero amplitude, Q = " << qText(fin, "Q")
+       << " over the span (its mean decay rate); compare resonators by Q0 or at one "
+          "amplitude. ";
+  else if (added == "gamma_a")
+    cs << "Damping grows linearly with the amplitude (clamping or friction-like loss at the "
+          "mount): Q0 = "
+       << qText(fin, "Q0") << ", Q = " << qText(fin, "Q")
+       << " over the span (its mean decay rate); check the clamping. ";
+  else if (added == "beat")
+    cs << "Two close modes beat in this channel: split "
+       << fmt(fin.derived.at("frequency_split_hz").value) << " Hz, Q1 = " << qText(fin, "Q_mode1")
+       << ", Q2 = " << qText(fin, "Q_mode2") << " (damping anisotropy "
+       << fmt(fin.derived.at("damping_anisotropy_1_s").value)
+       << " 1/s); the degenerate pair is split: trim it, or excite along one mode axis. ";
+  else if (added == "two_stage")
+    cs << "Two-stage decay: a fast stage (Q1 = " << qText(fin, "Q_mode1")
+       << ") then the slow one (Q2 = " << qText(fin, "Q_mode2")
+       << "): a second mode or a transient after switch-off; quote Q2. ";
+}
+
+/// 10. Causes and the sentence.
+void writeCause(ExplainState& st, const RingdownStep* best_step, bool negative) {
+  RingdownExplanation& x = st.x;
+  const RingdownExplainOptions& options = st.options;
   std::ostringstream cs;
   const auto& fin = x.final_fit;
-  auto qtext = [&](const std::string& k) {
-    const auto it = fin.derived.find(k);
-    if (it == fin.derived.end()) return std::string("n/a (no frequency)");
-    return fmt(it->second.value) + " [" + fmt(it->second.ci_low) + ", " + fmt(it->second.ci_high) +
-           "]";
-  };
   if (x.segment.has_floor) {
     x.causes.push_back("noise_floor");
     cs << "Noise floor at " << fmt(x.segment.floor_log_amplitude * kDbPerNeper) << " dB from "
@@ -570,38 +729,20 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
   if (best_step) {
     const RingdownStep* best = best_step;
     x.causes.push_back(best->added);
-    if (best->added == "gamma_nl")
-      cs << "Damping grows with the amplitude squared (gas or thermoelastic-like loss): Q0 = "
-         << qtext("Q0") << " at zero amplitude, Q = " << qtext("Q")
-         << " over the span (its mean decay rate); compare resonators by Q0 or at one "
-            "amplitude. ";
-    else if (best->added == "gamma_a")
-      cs << "Damping grows linearly with the amplitude (clamping or friction-like loss at the "
-            "mount): Q0 = "
-         << qtext("Q0") << ", Q = " << qtext("Q")
-         << " over the span (its mean decay rate); check the clamping. ";
-    else if (best->added == "beat")
-      cs << "Two close modes beat in this channel: split "
-         << fmt(fin.derived.at("frequency_split_hz").value) << " Hz, Q1 = " << qtext("Q_mode1")
-         << ", Q2 = " << qtext("Q_mode2") << " (damping anisotropy "
-         << fmt(fin.derived.at("damping_anisotropy_1_s").value)
-         << " 1/s); the degenerate pair is split: trim it, or excite along one mode axis. ";
-    else if (best->added == "two_stage")
-      cs << "Two-stage decay: a fast stage (Q1 = " << qtext("Q_mode1")
-         << ") then the slow one (Q2 = " << qtext("Q_mode2")
-         << "): a second mode or a transient after switch-off; quote Q2. ";
+    describeExtension(cs, best->added, fin);
   }
   if (x.unexplained) {
     x.causes.push_back("unexplained");
     cs << "Unexplained: the decay rate changes along the record without a physical damping law"
-       << (negative_law.empty() ? std::string(" (lack-of-fit p = " + fmt(x.lack_of_fit_p, 2) + ")")
-                                : std::string(" (an amplitude law fits only with a negative "
-                                              "coefficient: the decay accelerates as it falls)"))
+       << (st.negative_law.empty()
+               ? std::string(" (lack-of-fit p = " + fmt(x.lack_of_fit_p, 2) + ")")
+               : std::string(" (an amplitude law fits only with a negative "
+                             "coefficient: the decay accelerates as it falls)"))
        << ": drift of the mode out of the detection band or loss of detection; this Q is not "
           "reliable. ";
   }
   if (!best_step && !x.unexplained)
-    cs << "A single exponential decay explains the envelope: Q = " << qtext("Q") << ". ";
+    cs << "A single exponential decay explains the envelope: Q = " << qText(fin, "Q") << ". ";
   if (!x.unexplained && x.lack_of_fit_p < options.alpha)
     cs << "The residuals still curve (lack-of-fit p = " << fmt(x.lack_of_fit_p, 2)
        << "), but the local decay rate wanders by only "
@@ -611,6 +752,29 @@ RingdownExplanation explainRingdown(const RingdownEnvelope& env,
   if (negative) cs << "A fitted damping is negative: not an adequate model. ";
   x.cause = cs.str();
   if (!x.cause.empty() && x.cause.back() == ' ') x.cause.pop_back();
+}
+
+}  // namespace
+
+RingdownExplanation explainRingdown(const RingdownEnvelope& env,
+                                    const RingdownExplainOptions& options) {
+  const auto problems = options.validate();
+  if (!problems.empty()) throw InputError("ring-down explain: " + problems.front());
+  RingdownExplanation x;
+  x.segment = segmentRingdown(env, options.segmentation);
+  x.baseline = fitRingdown(env, x.segment, "linear", options.fit);
+  x.final_fit = x.baseline;
+  ExplainState st(env, options, &x);
+  fitCandidates(st);                              // 1.
+  st.ar = commonNoiseAr(st);                      // 2.
+  scoreCandidates(st);                            // 3.
+  rankCandidates(st);                             // 4.
+  chooseLawThroughFilter(st);                     // 5.
+  confirmPick(st);                                // 6.
+  const RingdownStep* pick = recordSteps(st);     // 7.
+  screenNegativeLaw(st);                          // 8.
+  const bool negative = judgeFinalFit(st, pick);  // 9.
+  writeCause(st, pick, negative);                 // 10.
   return x;
 }
 
