@@ -17,6 +17,9 @@
 namespace cvg_bench {
 namespace {
 
+/// Fewest response points a record must hold: the one-mode fit's minimum (fitResponse).
+constexpr size_t kMinResponsePoints = 8;
+
 const char* const kKeys[] = {"t", "frequency_hz", "x", "y", "drive", "direction"};
 
 std::string lowerTrimmed(const std::string& s) {
@@ -172,6 +175,114 @@ int directionOf(const std::string& field, double& num) {
   return 2;  // unparsable
 }
 
+/// Header row (step 2a): the named columns it holds; frequency_hz, x and y are required.
+void readHeaderRow(const std::vector<std::string>& fields, const std::string& where, int line_no,
+                   bool have_map, std::map<std::string, int>* col) {
+  if (have_map)
+    throw InputError(where + std::to_string(line_no) +
+                     ": the file has a header row; --columns is for headerless files");
+  for (size_t i = 0; i < fields.size(); ++i) {
+    const std::string name = headerName(fields[i]);
+    if (std::find(std::begin(kKeys), std::end(kKeys), name) != std::end(kKeys))
+      col->emplace(name, static_cast<int>(i));
+  }
+  for (const char* k : {"frequency_hz", "x", "y"})
+    if (!col->count(k))
+      throw InputError(where + std::to_string(line_no) + ": no column '" + k +
+                       "' in the header (named columns: " + knownKeys() +
+                       "; headerless files: --columns t=1,frequency_hz=2,x=3,y=4,drive=5)");
+}
+
+/// No header and no --columns (step 2b): the columns guessed from their count (and, for four,
+/// from what they hold: guessFourColumns), with a note saying how they were read.
+void guessHeaderlessColumns(const std::vector<std::string>& fields, const std::string& text,
+                            const std::string& where, int line_no, std::map<std::string, int>* col,
+                            ResponseRecord* rec) {
+  std::string guess_note;
+  if (fields.size() >= 5) {
+    *col = {{"t", 0}, {"frequency_hz", 1}, {"x", 2}, {"y", 3}, {"drive", 4}};
+    rec->notes.push_back(
+        "no header and no --columns: columns read as t, frequency_hz, x, y, drive");
+  } else if (fields.size() == 4 && !(*col = guessFourColumns(text, &guess_note)).empty()) {
+    rec->notes.push_back(guess_note);
+  } else if (fields.size() == 3) {
+    *col = {{"frequency_hz", 0}, {"x", 1}, {"y", 2}};
+    rec->notes.push_back(
+        "no header and no --columns: columns read as frequency_hz, x, y (one drive level)");
+  } else {
+    throw InputError(where + std::to_string(line_no) + ": " + std::to_string(fields.size()) +
+                     " columns and no header: give --columns t=N,frequency_hz=N,x=N,y=N,"
+                     "drive=N");
+  }
+}
+
+/// The finite number in the row's column of `key`.
+void readField(const std::vector<std::string>& fields, const std::map<std::string, int>& col,
+               const char* key, const std::string& where, int line_no, double& v) {
+  const int c = col.at(key);
+  if (c >= static_cast<int>(fields.size()))
+    throw InputError(where + std::to_string(line_no) + ": no field " + std::to_string(c + 1) +
+                     " (" + key + "); the row has " + std::to_string(fields.size()));
+  if (!parseNumber(fields[c], v) || !std::isfinite(v))
+    throw InputError(where + std::to_string(line_no) + ": field " + std::to_string(c + 1) + " (" +
+                     key + ") is not a finite number: '" + fields[c] + "'");
+}
+
+/// One data row (step 3): its values checked (frequency and drive > 0, time never going back,
+/// a direction when the column is there) and appended to `rec`; equal time stamps counted.
+void readDataRow(const std::vector<std::string>& fields, const std::map<std::string, int>& col,
+                 const std::string& where, int line_no, ResponseRecord* rec, size_t* time_ties) {
+  double f = 0, x = 0, y = 0, d = 1.0, tt = static_cast<double>(rec->size());
+  readField(fields, col, "frequency_hz", where, line_no, f);
+  readField(fields, col, "x", where, line_no, x);
+  readField(fields, col, "y", where, line_no, y);
+  if (col.count("drive")) readField(fields, col, "drive", where, line_no, d);
+  if (col.count("t")) readField(fields, col, "t", where, line_no, tt);
+  if (!(f > 0))
+    throw InputError(where + std::to_string(line_no) + ": frequency_hz must be > 0, got " +
+                     fields[col.at("frequency_hz")]);
+  if (!(d > 0))
+    throw InputError(where + std::to_string(line_no) +
+                     ": drive must be > 0 (a drive level per point), got " +
+                     fields[col.at("drive")]);
+  // Equal stamps are a coarse clock (the file's order is the time order); a stamp going back
+  // is two records joined or a wrong column.
+  if (!rec->t_s.empty() && tt < rec->t_s.back())
+    throw InputError(where + std::to_string(line_no) +
+                     ": time must increase (the file is read in time order), got " +
+                     std::to_string(tt) + " after " + std::to_string(rec->t_s.back()));
+  if (!rec->t_s.empty() && tt == rec->t_s.back()) ++*time_ties;
+  if (col.count("direction")) {
+    const int c = col.at("direction");
+    double num = 0;
+    const int dir = c < static_cast<int>(fields.size()) ? directionOf(fields[c], num) : 2;
+    if (dir == 2)
+      throw InputError(where + std::to_string(line_no) + ": field " + std::to_string(c + 1) +
+                       " (direction) must be up/down or a signed number");
+    rec->direction.push_back(dir);
+  }
+  rec->t_s.push_back(tt);
+  rec->frequency_hz.push_back(f);
+  rec->x.push_back(x);
+  rec->y.push_back(y);
+  rec->drive.push_back(d);
+}
+
+/// After the last row (step 4): notes on the clock and the drive, and the fit's minimum.
+void finishRecord(const std::map<std::string, int>& col, size_t time_ties,
+                  const std::string& source, ResponseRecord* rec) {
+  rec->has_time = col.count("t") > 0;
+  if (time_ties > 0)
+    rec->notes.push_back(std::to_string(time_ties) +
+                         " points share the time stamp of the point before (a coarse clock); the "
+                         "file's order is taken as the time order");
+  if (!col.count("drive") && rec->size() > 0)
+    rec->notes.push_back("no drive column: one drive level (1) assumed");
+  if (rec->size() < kMinResponsePoints)
+    throw InputError(source + ": " + std::to_string(rec->size()) +
+                     " response points; a one-mode fit needs at least 8");
+}
+
 }  // namespace
 
 ResponseKind parseResponseKind(const std::string& s) {
@@ -188,6 +299,7 @@ ResponseRecord readResponseText(const std::string& text, const std::string& sour
                                 const std::string& columns) {
   ResponseRecord rec;
   rec.source = source;
+  // 1. The columns from --columns, if given.
   std::map<std::string, int> col;
   bool have_map = false;
   if (!columns.empty()) {
@@ -198,7 +310,6 @@ ResponseRecord readResponseText(const std::string& text, const std::string& sour
   std::string line;
   int line_no = 0;
   bool first_row = true;
-  std::string guess_note;
   size_t time_ties = 0;
   const std::string where = source + ":";
   while (std::getline(in, line)) {
@@ -211,99 +322,25 @@ ResponseRecord readResponseText(const std::string& text, const std::string& sour
       continue;
     }
     const std::vector<std::string> fields = splitRow(line);
+    // 2. The first row: a header, or the first data row of a headerless file.
     if (first_row) {
       first_row = false;
       double v = 0;
       if (!parseNumber(fields[0], v)) {  // a header row
-        if (have_map)
-          throw InputError(where + std::to_string(line_no) +
-                           ": the file has a header row; --columns is for headerless files");
-        for (size_t i = 0; i < fields.size(); ++i) {
-          const std::string name = headerName(fields[i]);
-          if (std::find(std::begin(kKeys), std::end(kKeys), name) != std::end(kKeys))
-            col.emplace(name, static_cast<int>(i));
-        }
-        for (const char* k : {"frequency_hz", "x", "y"})
-          if (!col.count(k))
-            throw InputError(where + std::to_string(line_no) + ": no column '" + k +
-                             "' in the header (named columns: " + knownKeys() +
-                             "; headerless files: --columns t=1,frequency_hz=2,x=3,y=4,drive=5)");
+        readHeaderRow(fields, where, line_no, have_map, &col);
         have_map = true;
         continue;
       }
       if (!have_map) {
-        if (fields.size() >= 5) {
-          col = {{"t", 0}, {"frequency_hz", 1}, {"x", 2}, {"y", 3}, {"drive", 4}};
-          rec.notes.push_back(
-              "no header and no --columns: columns read as t, frequency_hz, x, y, drive");
-        } else if (fields.size() == 4 && !(col = guessFourColumns(text, &guess_note)).empty()) {
-          rec.notes.push_back(guess_note);
-        } else if (fields.size() == 3) {
-          col = {{"frequency_hz", 0}, {"x", 1}, {"y", 2}};
-          rec.notes.push_back(
-              "no header and no --columns: columns read as frequency_hz, x, y (one drive level)");
-        } else {
-          throw InputError(where + std::to_string(line_no) + ": " + std::to_string(fields.size()) +
-                           " columns and no header: give --columns t=N,frequency_hz=N,x=N,y=N,"
-                           "drive=N");
-        }
+        guessHeaderlessColumns(fields, text, where, line_no, &col, &rec);
         have_map = true;
       }
     }
-    auto value = [&](const char* key, double& v) {
-      const int c = col.at(key);
-      if (c >= static_cast<int>(fields.size()))
-        throw InputError(where + std::to_string(line_no) + ": no field " + std::to_string(c + 1) +
-                         " (" + key + "); the row has " + std::to_string(fields.size()));
-      if (!parseNumber(fields[c], v) || !std::isfinite(v))
-        throw InputError(where + std::to_string(line_no) + ": field " + std::to_string(c + 1) +
-                         " (" + key + ") is not a finite number: '" + fields[c] + "'");
-    };
-    double f = 0, x = 0, y = 0, d = 1.0, tt = static_cast<double>(rec.size());
-    value("frequency_hz", f);
-    value("x", x);
-    value("y", y);
-    if (col.count("drive")) value("drive", d);
-    if (col.count("t")) value("t", tt);
-    if (!(f > 0))
-      throw InputError(where + std::to_string(line_no) + ": frequency_hz must be > 0, got " +
-                       fields[col.at("frequency_hz")]);
-    if (!(d > 0))
-      throw InputError(where + std::to_string(line_no) +
-                       ": drive must be > 0 (a drive level per point), got " +
-                       fields[col.at("drive")]);
-    // Equal stamps are a coarse clock (the file's order is the time order); a stamp going back
-    // is two records joined or a wrong column.
-    if (!rec.t_s.empty() && tt < rec.t_s.back())
-      throw InputError(where + std::to_string(line_no) +
-                       ": time must increase (the file is read in time order), got " +
-                       std::to_string(tt) + " after " + std::to_string(rec.t_s.back()));
-    if (!rec.t_s.empty() && tt == rec.t_s.back()) ++time_ties;
-    if (col.count("direction")) {
-      const int c = col.at("direction");
-      double num = 0;
-      const int dir = c < static_cast<int>(fields.size()) ? directionOf(fields[c], num) : 2;
-      if (dir == 2)
-        throw InputError(where + std::to_string(line_no) + ": field " + std::to_string(c + 1) +
-                         " (direction) must be up/down or a signed number");
-      rec.direction.push_back(dir);
-    }
-    rec.t_s.push_back(tt);
-    rec.frequency_hz.push_back(f);
-    rec.x.push_back(x);
-    rec.y.push_back(y);
-    rec.drive.push_back(d);
+    // 3. The row's values.
+    readDataRow(fields, col, where, line_no, &rec, &time_ties);
   }
-  rec.has_time = col.count("t") > 0;
-  if (time_ties > 0)
-    rec.notes.push_back(std::to_string(time_ties) +
-                        " points share the time stamp of the point before (a coarse clock); the "
-                        "file's order is taken as the time order");
-  if (!col.count("drive") && rec.size() > 0)
-    rec.notes.push_back("no drive column: one drive level (1) assumed");
-  if (rec.size() < 8)
-    throw InputError(source + ": " + std::to_string(rec.size()) +
-                     " response points; a one-mode fit needs at least 8");
+  // 4. Notes and the minimum size.
+  finishRecord(col, time_ties, source, &rec);
   return rec;
 }
 

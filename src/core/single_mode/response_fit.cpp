@@ -20,6 +20,47 @@ namespace {
 
 using cd = std::complex<double>;
 
+/// Fewest points fitResponse takes (response_fit.h; the reader asks for as many).
+constexpr size_t kMinResponsePoints = 8;
+/// Largest lag-1 residual correlation the background-slope F test deflates its dof by.
+constexpr double kMaxSlopeTestLag1 = 0.95;
+/// Smallest dof the background-slope F test's denominator is given.
+constexpr double kMinSlopeTestDof = 4.0;
+/// Real parameters of the linear model with a background slope (f0, w, gain, bg0, bg1).
+constexpr double kSlopeModelParams = 8.0;
+/// F above which a background slope is fitted: ~p < 1e-6 for F(2, dof large).
+constexpr double kSlopeTestF = 15.0;
+/// Fewest points of a drive level for its own Lorentzian fit.
+constexpr size_t kMinLevelPoints = 8;
+/// Levenberg-Marquardt iterations of a drive level's own Lorentzian fit.
+constexpr int kLevelFitIterations = 200;
+/// The trend start's width at least this fraction of the first level's width.
+constexpr double kMinStartWidthFraction = 0.2;
+/// Median of |e| / sigma for complex Gaussian noise of sigma per component (sqrt(2 ln 2), rounded).
+constexpr double kMedianAbsPerSigma = 1.1774;
+/// Fewest free per-level residuals whose median is taken as a noise scale.
+constexpr size_t kMinResidualsForNoise = 8;
+/// Huber threshold in noise scales (a stage's: of the larger of noise and median misfit/1.1774).
+constexpr double kHuberNoiseScales = 3.0;
+/// Most Huber rounds of a robust refinement (the threshold following the misfit).
+constexpr int kMaxHuberRounds = 4;
+/// Levenberg-Marquardt iterations of each refinement of a start.
+constexpr int kRobustFitIterations = 300;
+/// Another Huber round only while the threshold falls below this fraction of the last.
+constexpr double kHuberShrinkForAnotherRound = 0.8;
+/// A direction is not determined below rank_tolerance times this relative singular value.
+constexpr double kWeakDirectionToleranceFactor = 1e3;
+/// A parameter takes part in a weak direction when its component in it exceeds this.
+constexpr double kWeakDirectionLoading = 0.3;
+/// Bartlett bandwidth within a sweep of m points: scale (m / points)^exponent point lags.
+constexpr double kBartlettBandwidthScale = 4.0;
+constexpr double kBartlettBandwidthPoints = 100.0;
+constexpr double kBartlettBandwidthExponent = 2.0 / 9.0;
+/// Levenberg-Marquardt iterations of each jackknife refit.
+constexpr int kJackknifeRefitIterations = 100;
+/// Gaussian kurtosis: 3 (sum d^2)^2 / sum d^4 is the effective number of deviations d.
+constexpr double kGaussianKurtosis = 3.0;
+
 /// Parameter vector: f0, w0, Re a, Im a, Re b0, Im b0, [Re b1, Im b1], [xi], [g].
 struct Layout {
   bool slope = false, xi = false, g = false;
@@ -239,7 +280,7 @@ double noiseFromDifferences(const ResponseData& d) {
       a.push_back(std::abs(d.z[i + 1] - 2.0 * d.z[i] + d.z[i - 1]));
   if (a.empty()) return 0.0;
   std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
-  return a[a.size() / 2] / (1.1774 * std::sqrt(6.0));
+  return a[a.size() / 2] / (kMedianAbsPerSigma * std::sqrt(6.0));
 }
 
 double lag1Along(const ResponseData& d, const std::vector<cd>& m) {
@@ -306,6 +347,578 @@ Eigen::MatrixXd jacobianAt(const ResponseData& d, const Layout& L, double f_ref,
 
 const char* const kParamNames[] = {"f0_hz", "width_hz", "gain", "gain", "background", "background"};
 
+/// What fitResponse's steps share: the data in normalised units and the model's layout.
+struct FitContext {
+  ResponseData d;         ///< normalised (and conjugated when the lock-in's y runs the other way)
+  size_t n = 0;           ///< number of points
+  double zs = 0, ds = 0;  ///< the response's largest magnitude, the drive's largest level
+  double f_ref = 0;       ///< middle of the swept band (the background slope's origin)
+  std::vector<int> all;   ///< every point's index
+  Layout L;
+};
+
+/// Step 1. Normalise: response by its largest magnitude, drive by its largest level.
+void normalise(const ResponseData& data_in, const ResponseFitOptions& o, FitContext* c) {
+  const size_t n = c->n;
+  double zs = 0, ds = 0;
+  for (size_t i = 0; i < n; ++i) {
+    zs = std::max(zs, std::abs(data_in.z[i]));
+    ds = std::max(ds, data_in.drive[i]);
+  }
+  if (!(zs > 0) || !(ds > 0)) throw AnalysisError("the response is zero everywhere");
+  c->zs = zs;
+  c->ds = ds;
+  c->d = data_in;
+  ResponseData& d = c->d;
+  d.kind = o.kind;
+  for (size_t i = 0; i < n; ++i) {
+    d.z[i] /= zs;
+    d.drive[i] /= ds;
+  }
+  c->all.resize(n);
+  std::iota(c->all.begin(), c->all.end(), 0);
+  c->f_ref = 0.5 * (*std::min_element(d.frequency_hz.begin(), d.frequency_hz.end()) +
+                    *std::max_element(d.frequency_hz.begin(), d.frequency_hz.end()));
+}
+
+/// Step 2. The lock-in's phase convention: the response turns one way through the resonance.
+/// Returns the linear fit (with a background slope) in the convention chosen.
+ResponseParams choosePhaseConvention(FitContext* c, ResponseFit* fit) {
+  ResponseParams lin, lin_conj;
+  const double rss_direct = gridLinear(c->d, c->all, true, c->f_ref, &lin);
+  ResponseData dc = c->d;
+  for (auto& z : dc.z) z = std::conj(z);
+  const double rss_conj = gridLinear(dc, c->all, true, c->f_ref, &lin_conj);
+  if (rss_conj < rss_direct) {
+    fit->conjugated = true;
+    c->d = dc;
+    lin = lin_conj;
+    fit->notes.push_back(
+        "phase convention: the response's phase falls through the resonance with y as written "
+        "taken as -Im (lock-in y = -quadrature); the fit used x - iy, results are independent of "
+        "it");
+  } else {
+    fit->notes.push_back(
+        "phase convention: x + iy with the phase of a displacement-like response falling by pi "
+        "through the resonance (lock-in y = +quadrature)");
+  }
+  return lin;
+}
+
+/// Step 3. The layout: the nonlinear terms asked for, and a background slope in frequency only
+/// where the data ask for it (F test, lag-1 deflated dof). `lin` becomes the linear fit without
+/// a slope when none is needed.
+void chooseLayout(const ResponseTerms& terms, FitContext* c, ResponseParams* lin,
+                  ResponseFit* fit) {
+  const ResponseData& d = c->d;
+  Layout& L = c->L;
+  L.xi = terms.backbone;
+  L.g = terms.width_growth;
+  {
+    ResponseParams no_slope;
+    const double rss0 = gridLinear(d, c->all, false, c->f_ref, &no_slope);
+    const double rss1 = projectLinear(d, c->all, lin->f0_hz, lin->width_hz, true, c->f_ref, lin);
+    const double rho =
+        std::max(0.0, std::min(kMaxSlopeTestLag1, lag1Along(d, stationaryResponse(*lin, d))));
+    const double dof =
+        std::max(kMinSlopeTestDof, (2.0 * c->n - kSlopeModelParams) * (1 - rho) / (1 + rho));
+    const double F = (rss0 - rss1) / 2.0 / (rss1 / dof);
+    L.slope = terms.background_slope || F > kSlopeTestF;
+    if (!L.slope) *lin = no_slope;
+  }
+  fit->notes.push_back(L.slope ? "background: constant + linear in frequency, per unit drive"
+                               : "background: constant per unit drive (a slope was not needed)");
+}
+
+/// Step 4. The points of each drive level, keyed by the level's mean drive (driveLevels: levels
+/// 1 % apart, a measured drive's noise stays within its level).
+std::map<double, std::vector<int>> pointsByDriveLevel(const ResponseData& d, size_t n) {
+  std::map<double, std::vector<int>> by_level;
+  const std::vector<int> level_of = driveLevels(d.drive);
+  std::map<int, std::vector<int>> members;
+  for (size_t i = 0; i < n; ++i) members[level_of[i]].push_back(static_cast<int>(i));
+  for (const auto& kv : members) {
+    double sum = 0.0;
+    for (int i : kv.second) sum += d.drive[i];
+    by_level[sum / static_cast<double>(kv.second.size())] = kv.second;
+  }
+  return by_level;
+}
+
+/// Step 5. Per-drive-level Lorentzians (fit->levels): the nonlinear start and the adequacy
+/// reference. Returns the |residual| of these free per-level fits (the noise scale).
+std::vector<double> fitEachLevel(const FitContext& c,
+                                 const std::map<double, std::vector<int>>& by_level,
+                                 ResponseFit* fit) {
+  const ResponseData& d = c.d;
+  std::vector<double> free_abs;
+  for (const auto& kv : by_level) {
+    if (kv.second.size() < kMinLevelPoints) continue;
+    ResponseParams p;
+    gridLinear(d, kv.second, c.L.slope, c.f_ref, &p);
+    const ResponseData dl = subset(d, kv.second);
+    Layout lin_layout;
+    lin_layout.slope = c.L.slope;
+    bool ok = false;
+    const ResponseParams pr = refine(dl, lin_layout, p, kLevelFitIterations, &ok);
+    if (ok && costOf(pr, dl) < costOf(p, dl)) p = pr;
+    const std::vector<cd> ml = stationaryResponse(p, dl);
+    for (size_t i = 0; i < ml.size(); ++i) free_abs.push_back(std::abs(dl.z[i] - ml[i]));
+    ResponseLevelFit lf;
+    lf.rss = costOf(p, dl) * c.zs * c.zs;
+    lf.drive = kv.first * c.ds;
+    lf.f0_hz = p.f0_hz;
+    lf.width_hz = p.width_hz;
+    lf.peak_u = std::norm(kv.first * p.gain / cd(0.0, p.f0_hz * p.width_hz));
+    lf.n_points = static_cast<int>(kv.second.size());
+    fit->levels.push_back(lf);
+  }
+  return free_abs;
+}
+
+/// Step 6. Starts: the linear fit, and for nonlinear terms the per-level trend of f0 and width
+/// in u (least squares over the levels' peaks).
+std::vector<ResponseParams> startsOf(const FitContext& c, const ResponseParams& lin,
+                                     const std::vector<ResponseLevelFit>& levels) {
+  const Layout& L = c.L;
+  std::vector<ResponseParams> starts = {lin};
+  if ((L.xi || L.g) && levels.size() >= 2) {
+    double su = 0, sf = 0, sw = 0, suu = 0, suf = 0, suw = 0;
+    const double m = static_cast<double>(levels.size());
+    for (const auto& lf : levels) {
+      su += lf.peak_u;
+      sf += lf.f0_hz;
+      sw += lf.width_hz;
+      suu += lf.peak_u * lf.peak_u;
+      suf += lf.peak_u * lf.f0_hz;
+      suw += lf.peak_u * lf.width_hz;
+    }
+    const double den = m * suu - su * su;
+    if (den > 0) {
+      ResponseParams s = lin;
+      const double xi = (m * suf - su * sf) / den, g = (m * suw - su * sw) / den;
+      s.f0_hz = (sf - xi * su) / m;
+      s.width_hz = std::max((sw - g * su) / m, kMinStartWidthFraction * levels.front().width_hz);
+      projectLinear(c.d, c.all, s.f0_hz, s.width_hz, L.slope, c.f_ref, &s);
+      if (L.xi) s.backbone_hz_per_amp2 = xi;
+      if (L.g) s.width_growth_hz_per_amp2 = g;
+      starts.push_back(s);
+      if (L.xi) {  // the same trend read as a backbone of the other sign
+        ResponseParams t = s;
+        t.backbone_hz_per_amp2 = -xi;
+        starts.push_back(t);
+      }
+    }
+  }
+  return starts;
+}
+
+/// Step 7. Noise scale: the smaller of the median |residual| of the free per-level fits (1.1774
+/// sigma for complex Gaussian noise; inflated where a level is not a Lorentzian) and the second
+/// differences' (which correlated noise lowers). Reorders `free_abs`.
+double noiseScale(const ResponseData& d, std::vector<double>* free_abs) {
+  double noise = noiseFromDifferences(d);
+  if (free_abs->size() >= kMinResidualsForNoise) {
+    std::nth_element(free_abs->begin(), free_abs->begin() + free_abs->size() / 2, free_abs->end());
+    noise = std::min(noise, (*free_abs)[free_abs->size() / 2] / kMedianAbsPerSigma);
+  }
+  return noise;
+}
+
+/// Step 8's Huber-weighted refinement of one start.
+struct RobustRefiner {
+  const ResponseData& d;
+  const Layout& L;
+  size_t n;
+  double noise;
+
+  /// The Huber threshold follows the fit's own misfit: 3 scales of the larger of the noise and
+  /// the median residual of the stage's start (a model that misses everywhere is not clipped
+  /// everywhere, which would stall Levenberg-Marquardt).
+  double deltaAt(const ResponseParams& p, BranchChoice c) const {
+    const std::vector<cd> m = stationaryResponse(p, d, nullptr, nullptr, c);
+    std::vector<double> a(n);
+    for (size_t i = 0; i < n; ++i) a[i] = std::abs(d.z[i] - m[i]);
+    std::nth_element(a.begin(), a.begin() + n / 2, a.end());
+    return kHuberNoiseScales * std::max(noise, a[n / 2] / kMedianAbsPerSigma);
+  }
+
+  /// A stage refines with the threshold of its start's misfit, then again while the misfit keeps
+  /// falling (at most 4 rounds), so a start far off is not clipped everywhere and a close one
+  /// ends with the noise's threshold.
+  ResponseParams robustRefine(ResponseParams t, BranchChoice c, bool* ok,
+                              double* delta_used) const {
+    double dl = deltaAt(t, c);
+    *ok = false;
+    for (int round = 0; round < kMaxHuberRounds; ++round) {
+      bool ok_round = false;
+      const ResponseParams p = refine(d, L, t, kRobustFitIterations, &ok_round, c, dl);
+      if (!ok_round) break;
+      *ok = true;
+      t = p;
+      const double next = deltaAt(t, c);
+      *delta_used = dl;
+      if (!(next < kHuberShrinkForAnotherRound * dl)) break;
+      dl = next;
+    }
+    return t;
+  }
+};
+
+/// Step 8's outcome: the best refit and the Huber threshold it ended with.
+struct BestFit {
+  ResponseParams params;
+  double delta = 0.0;
+};
+
+/// Step 8. Each start is refined three ways: on the smooth cost (the stable root nearest the
+/// data), then following the branch in time order from there, and on the branch directly. A
+/// point just past a fold sits on the other branch and its residual has no gradient that moves
+/// the fold; points caught mid-transient near a fold (critical slowing down) are off any
+/// stationary model. So the fit weighs points by Huber beyond 3 noise scales (from second
+/// differences along the sweeps); candidates are compared on 3 noise scales. Sets
+/// fit->converged when a refit converged.
+BestFit refineStarts(const FitContext& c, const std::vector<ResponseParams>& starts,
+                     const ResponseParams& lin, double noise, ResponseFit* fit) {
+  const ResponseData& d = c.d;
+  const Layout& L = c.L;
+  const RobustRefiner rr{d, L, c.n, noise};
+  double best_cost = std::numeric_limits<double>::infinity();
+  ResponseParams best = lin;
+  const double delta_compare = kHuberNoiseScales * noise;
+  double delta = delta_compare;
+  for (const ResponseParams& s : starts) {
+    std::vector<ResponseParams> tries = {s};
+    if (L.xi || L.g) {
+      bool ok_smooth = false;
+      double unused = 0.0;
+      const ResponseParams sm = rr.robustRefine(s, BranchChoice::kNearestData, &ok_smooth, &unused);
+      if (ok_smooth) tries.push_back(sm);
+    }
+    if (L.xi || L.g) {  // and the noise's threshold from the start (a fold's point clipped)
+      bool ok_fixed = false;
+      const ResponseParams sf = refine(d, L, s, kRobustFitIterations, &ok_fixed,
+                                       BranchChoice::kNearestData, delta_compare);
+      if (ok_fixed) tries.push_back(sf);
+    }
+    for (size_t k = 0; k < tries.size(); ++k) {
+      bool ok = false;
+      double used = delta_compare;
+      const ResponseParams p = k + 1 == tries.size() && (L.xi || L.g)
+                                   ? refine(d, L, tries[k], kRobustFitIterations, &ok,
+                                            BranchChoice::kFollow, delta_compare)
+                                   : rr.robustRefine(tries[k], BranchChoice::kFollow, &ok, &used);
+      const double cost = costOf(p, d, delta_compare);
+      if (ok && cost < best_cost) {
+        best_cost = cost;
+        best = p;
+        delta = used;
+        fit->converged = true;
+      }
+    }
+  }
+  return {best, delta};
+}
+
+/// Step 9. Statistics, model, parameters and point estimates in the input's units.
+void fillPointEstimates(const FitContext& c, const ResponseParams& best, double delta,
+                        ResponseFit* fit) {
+  const ResponseData& d = c.d;
+  const Layout& L = c.L;
+  const size_t n = c.n;
+  const double zs = c.zs, ds = c.ds;
+  std::vector<cd> m = stationaryResponse(best, d, &fit->u, &fit->jumps);
+  fit->residual_lag1 = lag1Along(d, m);
+  fit->n_points = static_cast<int>(n);
+  fit->n_params = L.size();
+  fit->n_sweeps = d.sweep.empty() ? 1 : *std::max_element(d.sweep.begin(), d.sweep.end()) + 1;
+  fit->rss = costOf(best, d) * zs * zs;
+  int far = 0;
+  for (size_t i = 0; i < n; ++i) far += std::abs(d.z[i] - m[i]) > delta ? 1 : 0;
+  fit->notes.push_back("Huber weights beyond " + std::to_string(delta * zs) +
+                       " (3 scales of the noise or of the median misfit): " + std::to_string(far) +
+                       " of " + std::to_string(n) + " points down-weighted");
+  fit->sigma = std::sqrt(fit->rss / std::max(1, static_cast<int>(2 * n) - L.size()));
+  for (auto& z : m) z = (fit->conjugated ? std::conj(z) : z) * zs;
+  fit->model = m;
+  for (auto& u : fit->u) u *= zs * zs;
+  for (auto& l : fit->levels) l.peak_u *= zs * zs;  // normalised until the starts were made
+  fit->params = best;
+  fit->params.gain *= zs / ds;
+  fit->params.bg0 *= zs / ds;
+  fit->params.bg1 *= zs / ds;
+  fit->params.backbone_hz_per_amp2 /= zs * zs;
+  fit->params.width_growth_hz_per_amp2 /= zs * zs;
+  const std::map<std::string, double> point = derivedOf(best, L, zs * zs);
+  for (const auto& kv : point) fit->derived[kv.first].value = kv.second;
+}
+
+/// Step 10. The amplitude law's check: would a free drive factor per level fit much better?
+void checkLevelGains(const FitContext& c, const std::map<double, std::vector<int>>& by_level,
+                     const ResponseParams& best, ResponseFit* fit) {
+  std::vector<int> level(c.n, 0);
+  int k = 0;
+  for (const auto& kv : by_level) {
+    for (int i : kv.second) level[i] = k;
+    ++k;
+  }
+  fit->rss_free_level_gains =
+      std::min(fit->rss, rssWithFreeDriveScales(c.d, c.L, best, level, k, 0.0) * c.zs * c.zs);
+}
+
+/// The column-scaled Jacobian at the optimum and its SVD.
+struct ScaledJacobian {
+  Eigen::VectorXd scale;  ///< column norms of J (1 for a zero column)
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd;
+  Eigen::VectorXd sv;  ///< singular values, largest first
+};
+
+/// Step 11a. The Jacobian at `best`, its columns scaled to unit norm, and its SVD.
+ScaledJacobian scaledJacobianAt(const FitContext& c, const ResponseParams& best) {
+  const std::vector<double> x = pack(best, c.L);
+  const Eigen::MatrixXd J = jacobianAt(c.d, c.L, c.f_ref, x);
+  if (J.size() == 0)
+    throw AnalysisError("the fitted response cannot be evaluated near the optimum");
+  ScaledJacobian sj;
+  sj.scale = J.colwise().norm();
+  for (int j = 0; j < sj.scale.size(); ++j) sj.scale(j) = sj.scale(j) > 0 ? sj.scale(j) : 1.0;
+  const Eigen::MatrixXd Js = J * sj.scale.cwiseInverse().asDiagonal();
+  sj.svd.compute(Js, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  sj.sv = sj.svd.singularValues();
+  return sj;
+}
+
+/// Step 11b. What the data cannot determine: near-null directions of the column-scaled Jacobian
+/// (fit->not_determined, and a note per gain or background component).
+void markNotDetermined(const Layout& L, const ScaledJacobian& sj, const ResponseFitOptions& o,
+                       ResponseFit* fit) {
+  const Eigen::VectorXd& sv = sj.sv;
+  std::vector<bool> weak(L.size(), false);
+  for (int k = 0; k < sv.size(); ++k) {
+    if (sv(k) > o.rank_tolerance * kWeakDirectionToleranceFactor * sv(0)) continue;
+    for (int j = 0; j < L.size(); ++j)
+      if (std::abs(sj.svd.matrixV()(j, k)) > kWeakDirectionLoading) weak[j] = true;
+  }
+  std::vector<std::string> weak_derived;
+  {
+    int k = 6 + (L.slope ? 2 : 0);
+    if (weak[0]) weak_derived.push_back("f0_hz");
+    if (weak[1]) weak_derived.push_back("width_hz");
+    if (weak[0] || weak[1]) weak_derived.push_back("Q");
+    if (L.xi && weak[k++]) weak_derived.push_back("backbone_hz_per_amp2");
+    if (L.g && weak[k]) weak_derived.push_back("width_growth_hz_per_amp2");
+    for (int j = 2; j < 6; ++j)
+      if (weak[j]) fit->notes.push_back(std::string(kParamNames[j]) + " is not determined");
+  }
+  fit->not_determined = weak_derived;
+}
+
+/// Step 12a. Sum over the sweeps of the Bartlett-weighted products of the points' scores (Jp
+/// times the Huber psi of the residual) within a sweep, bandwidth 4 (m/100)^(2/9) point lags.
+Eigen::MatrixXd withinSweepScoreProducts(const FitContext& c, const ResponseParams& best,
+                                         double delta, const Eigen::MatrixXd& Jp) {
+  const ResponseData& d = c.d;
+  const Layout& L = c.L;
+  const size_t n = c.n;
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(L.size(), L.size());
+  const std::vector<cd> mn = stationaryResponse(best, d);
+  size_t start = 0;
+  while (start < n) {
+    size_t end = start;
+    while (end < n && d.sweep[end] == d.sweep[start]) ++end;
+    const int mlen = static_cast<int>(end - start);
+    const int bw = static_cast<int>(
+        std::ceil(kBartlettBandwidthScale *
+                  std::pow(mlen / kBartlettBandwidthPoints, kBartlettBandwidthExponent)));
+    Eigen::MatrixXd S(L.size(), mlen);  // score of each point (both components)
+    for (int i = 0; i < mlen; ++i) {
+      const size_t pi = start + i;
+      cd e = d.z[pi] - mn[pi];
+      if (std::abs(e) > delta) e *= delta / std::abs(e);  // Huber's psi
+      S.col(i) = Jp.col(2 * pi) * e.real() + Jp.col(2 * pi + 1) * e.imag();
+    }
+    for (int lag = 0; lag <= std::min(bw, mlen - 1); ++lag) {
+      const double wgt = lag == 0 ? 1.0 : 1.0 - lag / (bw + 1.0);
+      Eigen::MatrixXd P = S.leftCols(mlen - lag) * S.rightCols(mlen - lag).transpose();
+      cov += lag == 0 ? P : Eigen::MatrixXd(wgt * (P + P.transpose()));
+    }
+    start = end;
+  }
+  return cov;
+}
+
+/// Step 12b. The within-sweep sandwich's standard errors of the derived quantities: cov = Jp K
+/// Jp', Jp the pseudo-inverse of J, K the residual products within a sweep (step 12a).
+std::map<std::string, double> sandwichStd(const FitContext& c, const ResponseParams& best,
+                                          double delta, const ScaledJacobian& sj,
+                                          const ResponseFitOptions& o) {
+  const Layout& L = c.L;
+  const double zs = c.zs;
+  const Eigen::VectorXd& sv = sj.sv;
+  const Eigen::VectorXd& scale = sj.scale;
+  std::map<std::string, double> sandwich_std;
+  const Eigen::MatrixXd Jp = sj.svd.matrixV() *
+                             sv.unaryExpr([&](double s) {
+                                 return s > o.rank_tolerance * sv(0) ? 1.0 / s : 0.0;
+                               }).asDiagonal() *
+                             sj.svd.matrixU().transpose();
+  Eigen::MatrixXd cov = withinSweepScoreProducts(c, best, delta, Jp);
+  cov = scale.cwiseInverse().asDiagonal() * cov * scale.cwiseInverse().asDiagonal();
+  auto sd = [&](const Eigen::VectorXd& grad) {
+    return std::sqrt(std::max(0.0, grad.dot(cov * grad)));
+  };
+  Eigen::VectorXd g0 = Eigen::VectorXd::Zero(L.size()), g1 = g0, gq = g0;
+  g0(0) = 1;
+  g1(1) = 1;
+  gq(0) = 1.0 / best.width_hz;
+  gq(1) = -best.f0_hz / (best.width_hz * best.width_hz);
+  sandwich_std["f0_hz"] = sd(g0);
+  sandwich_std["width_hz"] = sd(g1);
+  sandwich_std["Q"] = sd(gq);
+  int k = 6 + (L.slope ? 2 : 0);
+  if (L.xi) {
+    Eigen::VectorXd gx = Eigen::VectorXd::Zero(L.size());
+    gx(k++) = 1.0 / (zs * zs);
+    sandwich_std["backbone_hz_per_amp2"] = sd(gx);
+  }
+  if (L.g) {
+    Eigen::VectorXd gg = Eigen::VectorXd::Zero(L.size());
+    gg(k) = 1.0 / (zs * zs);
+    sandwich_std["width_growth_hz_per_amp2"] = sd(gg);
+  }
+  return sandwich_std;
+}
+
+/// Step 12c. The sandwich's standard errors as the intervals' (a jackknife may replace them).
+void applySandwich(const FitContext& c, const std::map<std::string, double>& sandwich_std, int G,
+                   ResponseFit* fit) {
+  fit->interval_dof = std::max(1, static_cast<int>(2 * c.n) - c.L.size());
+  for (const auto& kv : sandwich_std) {
+    ResponseValue& rv = fit->derived[kv.first];
+    rv.std = kv.second;
+    rv.dof = fit->interval_dof;
+  }
+  fit->interval_method = "sandwich with a Bartlett kernel within each sweep (" + std::to_string(G) +
+                         " sweeps: too few for a jackknife over sweeps), Student t";
+}
+
+/// Step 13a. The derived quantities refitted without each sweep in turn (the smooth stage
+/// first, continuous in the data, then the branch followed again); *used counts the refits
+/// that converged.
+std::map<std::string, std::vector<double>> leaveOneSweepOut(const FitContext& c,
+                                                            const ResponseParams& best,
+                                                            double delta, int G, int* used) {
+  const ResponseData& d = c.d;
+  const Layout& L = c.L;
+  std::map<std::string, std::vector<double>> reps;
+  for (int g = 0; g < G; ++g) {
+    std::vector<int> keep;
+    for (size_t i = 0; i < c.n; ++i)
+      if (d.sweep[i] != g) keep.push_back(static_cast<int>(i));
+    const ResponseData dg = subset(d, keep);
+    // The smooth stage first (continuous in the data), then the branch followed again.
+    bool ok_smooth = false, ok = false;
+    ResponseParams pg = best;
+    if (L.xi || L.g) {
+      const ResponseParams ps = refine(dg, L, best, kJackknifeRefitIterations, &ok_smooth,
+                                       BranchChoice::kNearestData, delta);
+      if (ok_smooth) pg = ps;
+    }
+    pg = refine(dg, L, pg, kJackknifeRefitIterations, &ok, BranchChoice::kFollow, delta);
+    if (!ok || !(pg.width_hz > 0)) continue;
+    ++*used;
+    for (const auto& kv : derivedOf(pg, L, c.zs * c.zs)) reps[kv.first].push_back(kv.second);
+  }
+  return reps;
+}
+
+/// Step 13b. With enough sweeps, a jackknife over whole sweeps, whose standard error is used
+/// unless the sandwich's is larger where a fold can trap a refit (a refit that cannot leave a
+/// fold-trap would make the jackknife's spread too small).
+void jackknifeOverSweeps(const FitContext& c, const ResponseParams& best, double delta, int G,
+                         const std::map<std::string, double>& sandwich_std, ResponseFit* fit) {
+  const Layout& L = c.L;
+  int used = 0;
+  const std::map<std::string, std::vector<double>> reps =
+      leaveOneSweepOut(c, best, delta, G, &used);
+  // Student t with the jackknife's effective degrees of freedom: G - 1 when the sweeps weigh
+  // alike, fewer when a few sweeps carry the estimate (the high drive levels, a drift of f0
+  // between sweeps): 3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations d (= G for
+  // Gaussian d of equal variance), at most G - 1.
+  fit->interval_dof = std::max(1, used - 1);
+  // The sandwich is a floor only where a fold can trap a refit (a nonlinear term). A linear
+  // model has no fold; there its sandwich, linearised once with unweighted bread under Huber
+  // weights, can exceed the refits' spread many times (the low half of the wire record
+  // example6: width sd 4.7 Hz against leave-one-out deviations of 0.05 Hz) and is not used.
+  const bool folds_possible = L.xi || L.g;
+  int min_dof = fit->interval_dof, floored = 0;
+  for (auto& kv : reps) {
+    const auto& v = kv.second;
+    const double mean = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+    double ss = 0, s4 = 0;
+    for (double a : v) {
+      ss += (a - mean) * (a - mean);
+      s4 += std::pow(a - mean, 4);
+    }
+    double sd = std::sqrt(ss * (v.size() - 1.0) / v.size());
+    const int dof = s4 > 0
+                        ? std::max(1, std::min(fit->interval_dof,
+                                               static_cast<int>(kGaussianKurtosis * ss * ss / s4)))
+                        : fit->interval_dof;
+    min_dof = std::min(min_dof, dof);
+    if (folds_possible && sandwich_std.count(kv.first) && sandwich_std.at(kv.first) > sd) {
+      sd = sandwich_std.at(kv.first);
+      ++floored;
+    }
+    ResponseValue& rv = fit->derived[kv.first];
+    rv.std = sd;
+    rv.dof = dof;
+  }
+  fit->interval_method = "jackknife over whole sweeps (" + std::to_string(used) + " of " +
+                         std::to_string(G) + " refits), Student t with the effective dof " +
+                         std::to_string(min_dof) + ".." + std::to_string(fit->interval_dof) +
+                         " (3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations); " +
+                         (folds_possible ? std::to_string(floored) +
+                                               " standard errors raised to the within-sweep "
+                                               "sandwich's"
+                                         : std::string("no fold, no sandwich floor"));
+  if (used < G)
+    fit->notes.push_back(std::to_string(G - used) + " jackknife refits did not converge");
+}
+
+/// Step 14. Student t intervals at o.confidence from each value's std and dof.
+void setIntervals(const ResponseFitOptions& o, ResponseFit* fit) {
+  for (auto& kv : fit->derived) {
+    ResponseValue& rv = kv.second;
+    const double t = studentQuantile(o.confidence, std::max(1, rv.dof));
+    rv.ci_low = rv.value - t * rv.std;
+    rv.ci_high = rv.value + t * rv.std;
+  }
+}
+
+/// Step 15. No resonance: a width whose interval reaches zero is not a mode's (noise, or a mode
+/// outside the swept band); nothing of it is reported as a number.
+void requireResonance(const ResponseFit& fit) {
+  const ResponseValue& w = fit.derived.at("width_hz");
+  if (!(w.ci_low > 0.0))
+    throw AnalysisError("no resonance determined by these data: the width's interval [" +
+                        std::to_string(w.ci_low) + ", " + std::to_string(w.ci_high) +
+                        "] Hz reaches zero (noise only, or the mode outside the swept band)");
+}
+
+/// Step 16. The model term's coefficient (gamma_nl_conventions.h): 8 pi times the width growth.
+void addGammaNlTerm(ResponseFit* fit) {
+  const auto g = fit->derived.find("width_growth_hz_per_amp2");
+  if (g != fit->derived.end()) {
+    ResponseValue t = g->second;
+    for (double* v : {&t.value, &t.std, &t.ci_low, &t.ci_high}) *v *= kGammaNlTermPerWidthGrowthHz;
+    fit->derived["gamma_nl_term"] = t;
+    if (std::find(fit->not_determined.begin(), fit->not_determined.end(), g->first) !=
+        fit->not_determined.end())
+      fit->not_determined.push_back("gamma_nl_term");
+  }
+}
+
 }  // namespace
 
 ResponseData responseDataOf(const ResponseRecord& r, ResponseKind kind) {
@@ -320,429 +933,41 @@ ResponseData responseDataOf(const ResponseRecord& r, ResponseKind kind) {
 
 ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
                         const ResponseFitOptions& o) {
-  const size_t n = data_in.size();
-  if (n < 8) throw AnalysisError("fewer than 8 response points");
+  FitContext c;
+  c.n = data_in.size();
+  if (c.n < kMinResponsePoints) throw AnalysisError("fewer than 8 response points");
   ResponseFit fit;
   fit.terms = terms;
   fit.kind = o.kind;
-  // Normalise: response by its largest magnitude, drive by its largest level.
-  double zs = 0, ds = 0;
-  for (size_t i = 0; i < n; ++i) {
-    zs = std::max(zs, std::abs(data_in.z[i]));
-    ds = std::max(ds, data_in.drive[i]);
-  }
-  if (!(zs > 0) || !(ds > 0)) throw AnalysisError("the response is zero everywhere");
-  ResponseData d = data_in;
-  d.kind = o.kind;
-  for (size_t i = 0; i < n; ++i) {
-    d.z[i] /= zs;
-    d.drive[i] /= ds;
-  }
-  std::vector<int> all(n);
-  std::iota(all.begin(), all.end(), 0);
-  const double f_ref = 0.5 * (*std::min_element(d.frequency_hz.begin(), d.frequency_hz.end()) +
-                              *std::max_element(d.frequency_hz.begin(), d.frequency_hz.end()));
-  // The lock-in's phase convention: the response turns one way through the resonance.
-  ResponseParams lin, lin_conj;
-  const double rss_direct = gridLinear(d, all, true, f_ref, &lin);
-  ResponseData dc = d;
-  for (auto& z : dc.z) z = std::conj(z);
-  const double rss_conj = gridLinear(dc, all, true, f_ref, &lin_conj);
-  if (rss_conj < rss_direct) {
-    fit.conjugated = true;
-    d = dc;
-    lin = lin_conj;
-    fit.notes.push_back(
-        "phase convention: the response's phase falls through the resonance with y as written "
-        "taken as -Im (lock-in y = -quadrature); the fit used x - iy, results are independent of "
-        "it");
-  } else {
-    fit.notes.push_back(
-        "phase convention: x + iy with the phase of a displacement-like response falling by pi "
-        "through the resonance (lock-in y = +quadrature)");
-  }
-  // Background slope in frequency only where the data ask for it (F test, lag-1 deflated dof).
-  Layout L;
-  L.xi = terms.backbone;
-  L.g = terms.width_growth;
-  {
-    ResponseParams no_slope;
-    const double rss0 = gridLinear(d, all, false, f_ref, &no_slope);
-    const double rss1 = projectLinear(d, all, lin.f0_hz, lin.width_hz, true, f_ref, &lin);
-    const double rho = std::max(0.0, std::min(0.95, lag1Along(d, stationaryResponse(lin, d))));
-    const double dof = std::max(4.0, (2.0 * n - 8) * (1 - rho) / (1 + rho));
-    const double F = (rss0 - rss1) / 2.0 / (rss1 / dof);
-    L.slope = terms.background_slope || F > 15.0;  // ~p < 1e-6 for F(2, dof large)
-    if (!L.slope) lin = no_slope;
-  }
-  fit.notes.push_back(L.slope ? "background: constant + linear in frequency, per unit drive"
-                              : "background: constant per unit drive (a slope was not needed)");
-  // Per-drive-level Lorentzians: the nonlinear start and the adequacy reference.
-  // Keyed by the level's mean drive (driveLevels: levels 1 % apart, a measured drive's noise
-  // stays within its level).
-  std::map<double, std::vector<int>> by_level;
-  {
-    const std::vector<int> level_of = driveLevels(d.drive);
-    std::map<int, std::vector<int>> members;
-    for (size_t i = 0; i < n; ++i) members[level_of[i]].push_back(static_cast<int>(i));
-    for (const auto& kv : members) {
-      double sum = 0.0;
-      for (int i : kv.second) sum += d.drive[i];
-      by_level[sum / static_cast<double>(kv.second.size())] = kv.second;
-    }
-  }
-  std::vector<double> free_abs;  // |residual| of the free per-level fits (the noise scale)
-  for (const auto& kv : by_level) {
-    if (kv.second.size() < 8) continue;
-    ResponseParams p;
-    gridLinear(d, kv.second, L.slope, f_ref, &p);
-    const ResponseData dl = subset(d, kv.second);
-    Layout lin_layout;
-    lin_layout.slope = L.slope;
-    bool ok = false;
-    const ResponseParams pr = refine(dl, lin_layout, p, 200, &ok);
-    if (ok && costOf(pr, dl) < costOf(p, dl)) p = pr;
-    const std::vector<cd> ml = stationaryResponse(p, dl);
-    for (size_t i = 0; i < ml.size(); ++i) free_abs.push_back(std::abs(dl.z[i] - ml[i]));
-    ResponseLevelFit lf;
-    lf.rss = costOf(p, dl) * zs * zs;
-    lf.drive = kv.first * ds;
-    lf.f0_hz = p.f0_hz;
-    lf.width_hz = p.width_hz;
-    lf.peak_u = std::norm(kv.first * p.gain / cd(0.0, p.f0_hz * p.width_hz));
-    lf.n_points = static_cast<int>(kv.second.size());
-    fit.levels.push_back(lf);
-  }
+  normalise(data_in, o, &c);
+  ResponseParams lin = choosePhaseConvention(&c, &fit);
+  chooseLayout(terms, &c, &lin, &fit);
+  const std::map<double, std::vector<int>> by_level = pointsByDriveLevel(c.d, c.n);
+  std::vector<double> free_abs = fitEachLevel(c, by_level, &fit);
   fit.n_drive_levels = static_cast<int>(by_level.size());
-  // Starts: the linear fit, and for nonlinear terms the per-level trend of f0 and width in u.
-  std::vector<ResponseParams> starts = {lin};
-  if ((L.xi || L.g) && fit.levels.size() >= 2) {
-    double su = 0, sf = 0, sw = 0, suu = 0, suf = 0, suw = 0;
-    const double m = static_cast<double>(fit.levels.size());
-    for (const auto& lf : fit.levels) {
-      su += lf.peak_u;
-      sf += lf.f0_hz;
-      sw += lf.width_hz;
-      suu += lf.peak_u * lf.peak_u;
-      suf += lf.peak_u * lf.f0_hz;
-      suw += lf.peak_u * lf.width_hz;
-    }
-    const double den = m * suu - su * su;
-    if (den > 0) {
-      ResponseParams s = lin;
-      const double xi = (m * suf - su * sf) / den, g = (m * suw - su * sw) / den;
-      s.f0_hz = (sf - xi * su) / m;
-      s.width_hz = std::max((sw - g * su) / m, 0.2 * fit.levels.front().width_hz);
-      projectLinear(d, all, s.f0_hz, s.width_hz, L.slope, f_ref, &s);
-      if (L.xi) s.backbone_hz_per_amp2 = xi;
-      if (L.g) s.width_growth_hz_per_amp2 = g;
-      starts.push_back(s);
-      if (L.xi) {  // the same trend read as a backbone of the other sign
-        ResponseParams t = s;
-        t.backbone_hz_per_amp2 = -xi;
-        starts.push_back(t);
-      }
-    }
-  }
-  double best_cost = std::numeric_limits<double>::infinity();
-  ResponseParams best = lin;
-  // Each start is refined three ways: on the smooth cost (the stable root nearest the data), then
-  // following the branch in time order from there, and on the branch directly. A point just past a
-  // fold sits on the other branch and its residual has no gradient that moves the fold; points
-  // caught mid-transient near a fold (critical slowing down) are off any stationary model. So the
-  // fit weighs points by Huber beyond 3 noise scales (from second differences along the sweeps).
-  // Noise scale: the smaller of the median |residual| of the free per-level fits (1.1774 sigma for
-  // complex Gaussian noise; inflated where a level is not a Lorentzian) and the second
-  // differences' (which correlated noise lowers).
-  double noise = noiseFromDifferences(d);
-  if (free_abs.size() >= 8) {
-    std::nth_element(free_abs.begin(), free_abs.begin() + free_abs.size() / 2, free_abs.end());
-    noise = std::min(noise, free_abs[free_abs.size() / 2] / 1.1774);
-  }
-  // The Huber threshold follows the fit's own misfit: 3 scales of the larger of the noise and
-  // the median residual of the stage's start (a model that misses everywhere is not clipped
-  // everywhere, which would stall Levenberg-Marquardt); candidates are compared on 3 noise scales.
-  auto deltaAt = [&](const ResponseParams& p, BranchChoice c) {
-    const std::vector<cd> m = stationaryResponse(p, d, nullptr, nullptr, c);
-    std::vector<double> a(n);
-    for (size_t i = 0; i < n; ++i) a[i] = std::abs(d.z[i] - m[i]);
-    std::nth_element(a.begin(), a.begin() + n / 2, a.end());
-    return 3.0 * std::max(noise, a[n / 2] / 1.1774);
-  };
-  // A stage refines with the threshold of its start's misfit, then again while the misfit keeps
-  // falling (at most 4 rounds), so a start far off is not clipped everywhere and a close one
-  // ends with the noise's threshold.
-  auto robustRefine = [&](ResponseParams t, BranchChoice c, bool* ok, double* delta_used) {
-    double dl = deltaAt(t, c);
-    *ok = false;
-    for (int round = 0; round < 4; ++round) {
-      bool ok_round = false;
-      const ResponseParams p = refine(d, L, t, 300, &ok_round, c, dl);
-      if (!ok_round) break;
-      *ok = true;
-      t = p;
-      const double next = deltaAt(t, c);
-      *delta_used = dl;
-      if (!(next < 0.8 * dl)) break;
-      dl = next;
-    }
-    return t;
-  };
-  const double delta_compare = 3.0 * noise;
-  double delta = delta_compare;
-  for (const ResponseParams& s : starts) {
-    std::vector<ResponseParams> tries = {s};
-    if (L.xi || L.g) {
-      bool ok_smooth = false;
-      double unused = 0.0;
-      const ResponseParams sm = robustRefine(s, BranchChoice::kNearestData, &ok_smooth, &unused);
-      if (ok_smooth) tries.push_back(sm);
-    }
-    if (L.xi || L.g) {  // and the noise's threshold from the start (a fold's point clipped)
-      bool ok_fixed = false;
-      const ResponseParams sf =
-          refine(d, L, s, 300, &ok_fixed, BranchChoice::kNearestData, delta_compare);
-      if (ok_fixed) tries.push_back(sf);
-    }
-    for (size_t k = 0; k < tries.size(); ++k) {
-      bool ok = false;
-      double used = delta_compare;
-      const ResponseParams p =
-          k + 1 == tries.size() && (L.xi || L.g)
-              ? refine(d, L, tries[k], 300, &ok, BranchChoice::kFollow, delta_compare)
-              : robustRefine(tries[k], BranchChoice::kFollow, &ok, &used);
-      const double c = costOf(p, d, delta_compare);
-      if (ok && c < best_cost) {
-        best_cost = c;
-        best = p;
-        delta = used;
-        fit.converged = true;
-      }
-    }
-  }
+  const std::vector<ResponseParams> starts = startsOf(c, lin, fit.levels);
+  const double noise = noiseScale(c.d, &free_abs);
+  const BestFit bf = refineStarts(c, starts, lin, noise, &fit);
+  const ResponseParams& best = bf.params;
+  const double delta = bf.delta;
   if (!fit.converged || !(best.width_hz > 0))
     throw AnalysisError("the response fit did not converge");
-  // Statistics in the input's units.
-  std::vector<cd> m = stationaryResponse(best, d, &fit.u, &fit.jumps);
-  fit.residual_lag1 = lag1Along(d, m);
-  fit.n_points = static_cast<int>(n);
-  fit.n_params = L.size();
-  fit.n_sweeps = d.sweep.empty() ? 1 : *std::max_element(d.sweep.begin(), d.sweep.end()) + 1;
-  fit.rss = costOf(best, d) * zs * zs;
-  int far = 0;
-  for (size_t i = 0; i < n; ++i) far += std::abs(d.z[i] - m[i]) > delta ? 1 : 0;
-  fit.notes.push_back("Huber weights beyond " + std::to_string(delta * zs) +
-                      " (3 scales of the noise or of the median misfit): " + std::to_string(far) +
-                      " of " + std::to_string(n) + " points down-weighted");
-  fit.sigma = std::sqrt(fit.rss / std::max(1, static_cast<int>(2 * n) - L.size()));
-  for (auto& z : m) z = (fit.conjugated ? std::conj(z) : z) * zs;
-  fit.model = m;
-  for (auto& u : fit.u) u *= zs * zs;
-  for (auto& l : fit.levels) l.peak_u *= zs * zs;  // normalised until the starts were made
-  fit.params = best;
-  fit.params.gain *= zs / ds;
-  fit.params.bg0 *= zs / ds;
-  fit.params.bg1 *= zs / ds;
-  fit.params.backbone_hz_per_amp2 /= zs * zs;
-  fit.params.width_growth_hz_per_amp2 /= zs * zs;
-  const std::map<std::string, double> point = derivedOf(best, L, zs * zs);
-  for (const auto& kv : point) fit.derived[kv.first].value = kv.second;
-  // The amplitude law's check: would a free drive factor per level fit much better?
-  if (o.level_gain_check && by_level.size() >= 2) {
-    std::vector<int> level(n, 0);
-    int k = 0;
-    for (const auto& kv : by_level) {
-      for (int i : kv.second) level[i] = k;
-      ++k;
-    }
-    fit.rss_free_level_gains =
-        std::min(fit.rss, rssWithFreeDriveScales(d, L, best, level, k, 0.0) * zs * zs);
-  }
+  fillPointEstimates(c, best, delta, &fit);
+  if (o.level_gain_check && by_level.size() >= 2) checkLevelGains(c, by_level, best, &fit);
   if (!o.intervals) return fit;
 
-  // What the data cannot determine: near-null directions of the column-scaled Jacobian.
-  const std::vector<double> x = pack(best, L);
-  const Eigen::MatrixXd J = jacobianAt(d, L, f_ref, x);
-  if (J.size() == 0)
-    throw AnalysisError("the fitted response cannot be evaluated near the optimum");
-  Eigen::VectorXd scale = J.colwise().norm();
-  for (int j = 0; j < scale.size(); ++j) scale(j) = scale(j) > 0 ? scale(j) : 1.0;
-  const Eigen::MatrixXd Js = J * scale.cwiseInverse().asDiagonal();
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Js, Eigen::ComputeThinU | Eigen::ComputeThinV);
-  const Eigen::VectorXd sv = svd.singularValues();
-  std::vector<bool> weak(L.size(), false);
-  for (int k = 0; k < sv.size(); ++k) {
-    if (sv(k) > o.rank_tolerance * 1e3 * sv(0)) continue;
-    for (int j = 0; j < L.size(); ++j)
-      if (std::abs(svd.matrixV()(j, k)) > 0.3) weak[j] = true;
-  }
-  std::vector<std::string> weak_derived;
-  {
-    int k = 6 + (L.slope ? 2 : 0);
-    if (weak[0]) weak_derived.push_back("f0_hz");
-    if (weak[1]) weak_derived.push_back("width_hz");
-    if (weak[0] || weak[1]) weak_derived.push_back("Q");
-    if (L.xi && weak[k++]) weak_derived.push_back("backbone_hz_per_amp2");
-    if (L.g && weak[k]) weak_derived.push_back("width_growth_hz_per_amp2");
-    for (int j = 2; j < 6; ++j)
-      if (weak[j]) fit.notes.push_back(std::string(kParamNames[j]) + " is not determined");
-  }
-  fit.not_determined = weak_derived;
-
-  // Intervals. The within-sweep sandwich always (cov = Jp K Jp', Jp the pseudo-inverse of J, K
-  // the residual products within a sweep weighted by a Bartlett kernel over point lags, bandwidth
-  // 4 (m/100)^(2/9)); with 5 or more sweeps also a jackknife over whole sweeps, whose standard
-  // error is used unless the sandwich's is larger (a refit that cannot leave a fold-trap would
-  // make the jackknife's spread too small).
+  const ScaledJacobian sj = scaledJacobianAt(c, best);
+  markNotDetermined(c.L, sj, o, &fit);
+  // Intervals. The within-sweep sandwich always; with 5 or more sweeps also a jackknife over
+  // whole sweeps, whose standard error is used unless the sandwich's is larger (a refit that
+  // cannot leave a fold-trap would make the jackknife's spread too small).
   const int G = fit.n_sweeps;
-  std::map<std::string, double> sandwich_std;
-  {
-    const Eigen::MatrixXd Jp = svd.matrixV() *
-                               sv.unaryExpr([&](double s) {
-                                   return s > o.rank_tolerance * sv(0) ? 1.0 / s : 0.0;
-                                 }).asDiagonal() *
-                               svd.matrixU().transpose();
-    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(L.size(), L.size());
-    const std::vector<cd> mn = stationaryResponse(best, d);
-    size_t start = 0;
-    while (start < n) {
-      size_t end = start;
-      while (end < n && d.sweep[end] == d.sweep[start]) ++end;
-      const int mlen = static_cast<int>(end - start);
-      const int bw = static_cast<int>(std::ceil(4.0 * std::pow(mlen / 100.0, 2.0 / 9.0)));
-      Eigen::MatrixXd S(L.size(), mlen);  // score of each point (both components)
-      for (int i = 0; i < mlen; ++i) {
-        const size_t pi = start + i;
-        cd e = d.z[pi] - mn[pi];
-        if (std::abs(e) > delta) e *= delta / std::abs(e);  // Huber's psi
-        S.col(i) = Jp.col(2 * pi) * e.real() + Jp.col(2 * pi + 1) * e.imag();
-      }
-      for (int lag = 0; lag <= std::min(bw, mlen - 1); ++lag) {
-        const double wgt = lag == 0 ? 1.0 : 1.0 - lag / (bw + 1.0);
-        Eigen::MatrixXd P = S.leftCols(mlen - lag) * S.rightCols(mlen - lag).transpose();
-        cov += lag == 0 ? P : Eigen::MatrixXd(wgt * (P + P.transpose()));
-      }
-      start = end;
-    }
-    cov = scale.cwiseInverse().asDiagonal() * cov * scale.cwiseInverse().asDiagonal();
-    auto sd = [&](const Eigen::VectorXd& grad) {
-      return std::sqrt(std::max(0.0, grad.dot(cov * grad)));
-    };
-    Eigen::VectorXd g0 = Eigen::VectorXd::Zero(L.size()), g1 = g0, gq = g0;
-    g0(0) = 1;
-    g1(1) = 1;
-    gq(0) = 1.0 / best.width_hz;
-    gq(1) = -best.f0_hz / (best.width_hz * best.width_hz);
-    sandwich_std["f0_hz"] = sd(g0);
-    sandwich_std["width_hz"] = sd(g1);
-    sandwich_std["Q"] = sd(gq);
-    int k = 6 + (L.slope ? 2 : 0);
-    if (L.xi) {
-      Eigen::VectorXd gx = Eigen::VectorXd::Zero(L.size());
-      gx(k++) = 1.0 / (zs * zs);
-      sandwich_std["backbone_hz_per_amp2"] = sd(gx);
-    }
-    if (L.g) {
-      Eigen::VectorXd gg = Eigen::VectorXd::Zero(L.size());
-      gg(k) = 1.0 / (zs * zs);
-      sandwich_std["width_growth_hz_per_amp2"] = sd(gg);
-    }
-  }
-  fit.interval_dof = std::max(1, static_cast<int>(2 * n) - L.size());
-  for (const auto& kv : sandwich_std) {
-    ResponseValue& rv = fit.derived[kv.first];
-    rv.std = kv.second;
-    rv.dof = fit.interval_dof;
-  }
-  fit.interval_method = "sandwich with a Bartlett kernel within each sweep (" + std::to_string(G) +
-                        " sweeps: too few for a jackknife over sweeps), Student t";
-  if (G >= o.min_sweeps_for_jackknife) {
-    std::map<std::string, std::vector<double>> reps;
-    int used = 0;
-    for (int g = 0; g < G; ++g) {
-      std::vector<int> keep;
-      for (size_t i = 0; i < n; ++i)
-        if (d.sweep[i] != g) keep.push_back(static_cast<int>(i));
-      const ResponseData dg = subset(d, keep);
-      // The smooth stage first (continuous in the data), then the branch followed again.
-      bool ok_smooth = false, ok = false;
-      ResponseParams pg = best;
-      if (L.xi || L.g) {
-        const ResponseParams ps =
-            refine(dg, L, best, 100, &ok_smooth, BranchChoice::kNearestData, delta);
-        if (ok_smooth) pg = ps;
-      }
-      pg = refine(dg, L, pg, 100, &ok, BranchChoice::kFollow, delta);
-      if (!ok || !(pg.width_hz > 0)) continue;
-      ++used;
-      for (const auto& kv : derivedOf(pg, L, zs * zs)) reps[kv.first].push_back(kv.second);
-    }
-    // Student t with the jackknife's effective degrees of freedom: G - 1 when the sweeps weigh
-    // alike, fewer when a few sweeps carry the estimate (the high drive levels, a drift of f0
-    // between sweeps): 3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations d (= G for
-    // Gaussian d of equal variance), at most G - 1.
-    fit.interval_dof = std::max(1, used - 1);
-    // The sandwich is a floor only where a fold can trap a refit (a nonlinear term). A linear
-    // model has no fold; there its sandwich, linearised once with unweighted bread under Huber
-    // weights, can exceed the refits' spread many times (the low half of the wire record
-    // example6: width sd 4.7 Hz against leave-one-out deviations of 0.05 Hz) and is not used.
-    const bool folds_possible = L.xi || L.g;
-    int min_dof = fit.interval_dof, floored = 0;
-    for (auto& kv : reps) {
-      const auto& v = kv.second;
-      const double mean = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
-      double ss = 0, s4 = 0;
-      for (double a : v) {
-        ss += (a - mean) * (a - mean);
-        s4 += std::pow(a - mean, 4);
-      }
-      double sd = std::sqrt(ss * (v.size() - 1.0) / v.size());
-      const int dof =
-          s4 > 0 ? std::max(1, std::min(fit.interval_dof, static_cast<int>(3.0 * ss * ss / s4)))
-                 : fit.interval_dof;
-      min_dof = std::min(min_dof, dof);
-      if (folds_possible && sandwich_std.count(kv.first) && sandwich_std[kv.first] > sd) {
-        sd = sandwich_std[kv.first];
-        ++floored;
-      }
-      ResponseValue& rv = fit.derived[kv.first];
-      rv.std = sd;
-      rv.dof = dof;
-    }
-    fit.interval_method = "jackknife over whole sweeps (" + std::to_string(used) + " of " +
-                          std::to_string(G) + " refits), Student t with the effective dof " +
-                          std::to_string(min_dof) + ".." + std::to_string(fit.interval_dof) +
-                          " (3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations); " +
-                          (folds_possible ? std::to_string(floored) +
-                                                " standard errors raised to the within-sweep "
-                                                "sandwich's"
-                                          : std::string("no fold, no sandwich floor"));
-    if (used < G)
-      fit.notes.push_back(std::to_string(G - used) + " jackknife refits did not converge");
-  }
-  for (auto& kv : fit.derived) {
-    ResponseValue& rv = kv.second;
-    const double t = studentQuantile(o.confidence, std::max(1, rv.dof));
-    rv.ci_low = rv.value - t * rv.std;
-    rv.ci_high = rv.value + t * rv.std;
-  }
-  // No resonance: a width whose interval reaches zero is not a mode's (noise, or a mode outside
-  // the swept band); nothing of it is reported as a number.
-  const ResponseValue& w = fit.derived.at("width_hz");
-  if (!(w.ci_low > 0.0))
-    throw AnalysisError("no resonance determined by these data: the width's interval [" +
-                        std::to_string(w.ci_low) + ", " + std::to_string(w.ci_high) +
-                        "] Hz reaches zero (noise only, or the mode outside the swept band)");
-  // The model term's coefficient (gamma_nl_conventions.h): 8 pi times the width growth.
-  const auto g = fit.derived.find("width_growth_hz_per_amp2");
-  if (g != fit.derived.end()) {
-    ResponseValue t = g->second;
-    for (double* v : {&t.value, &t.std, &t.ci_low, &t.ci_high}) *v *= kGammaNlTermPerWidthGrowthHz;
-    fit.derived["gamma_nl_term"] = t;
-    if (std::find(fit.not_determined.begin(), fit.not_determined.end(), g->first) !=
-        fit.not_determined.end())
-      fit.not_determined.push_back("gamma_nl_term");
-  }
+  const std::map<std::string, double> sandwich_std = sandwichStd(c, best, delta, sj, o);
+  applySandwich(c, sandwich_std, G, &fit);
+  if (G >= o.min_sweeps_for_jackknife) jackknifeOverSweeps(c, best, delta, G, sandwich_std, &fit);
+  setIntervals(o, &fit);
+  requireResonance(fit);
+  addGammaNlTerm(&fit);
   return fit;
 }
 
