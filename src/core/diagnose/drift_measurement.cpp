@@ -16,6 +16,34 @@ namespace cvg_bench {
 
 namespace {
 
+/// Fewest and most theta bins over one period (the InputError text says "4 .. 3600").
+constexpr int kMinBins = 4;
+constexpr int kMaxBins = 3600;
+/// A sample's pattern angle is used where r^2 - k^2 is at least this fraction of r^2 (at r = |k|,
+/// a travelling wave, theta is undefined).
+constexpr double kMinStandingFraction = 1e-4;
+/// Fewest samples with a pattern angle per theta bin.
+constexpr int kMinSamplesPerBin = 4;
+/// The run's theta must cover at least this fraction of its period pi/2 (the text says "3/4").
+constexpr double kMinCoveredFraction = 0.75;
+/// Half-window of the centred moving average of theta, as a fraction of the samples per bin
+/// crossing (about a quarter of a pass), and its bounds in samples.
+constexpr double kHalfWindowFraction = 0.125;
+constexpr int kMinHalfWindow = 2;
+constexpr int kMaxHalfWindow = 50;
+/// A pass counts with at least this many samples (the text says "6 samples or more") ...
+constexpr size_t kMinPassSamples = 6;
+/// ... crossing at least this fraction of the bin.
+constexpr double kMinPassTravel = 0.5;
+/// Largest lag-1 correlation of the pooled noise taken into its AR(1) long-run factor.
+constexpr double kMaxNoiseLag1 = 0.9;
+/// Floor of a pass's slope variance (keeps the inverse-variance weights finite).
+constexpr double kMinPassVariance = 1e-300;
+/// Student's quantile at the noise dof is taken at no more dof than this (normal by then).
+constexpr long kMaxQuantileDof = 100000;
+/// rad/s -> deg/h (the summary's unit).
+constexpr double kDegPerHourPerRadPerSec = 180.0 / M_PI * 3600.0;
+
 double median(const std::vector<double>& v) {
   return sampleMedian(v);
 }
@@ -46,6 +74,265 @@ ParameterEstimate binDriftWithInterval(const ResonatorModel& model, double r, do
   return deltaMethod(crossing, params);
 }
 
+/// The slow samples where the pattern angle is defined: time, theta ((5.2), unwrapped across its
+/// period pi/2), r and k.
+struct PatternTrack {
+  std::vector<double> t, th, rs, ks;
+};
+
+PatternTrack trackPatternAngle(const SlowRecord& record) {
+  PatternTrack p;
+  double unwrap = 0.0, last = 0.0;
+  for (size_t i = 0; i < record.size(); ++i) {
+    const OrbitElements e = orbitFromSlow(record.q[i]);
+    if (!(e.r > 0.0) || e.r * e.r - e.k * e.k < kMinStandingFraction * e.r * e.r) continue;
+    if (!p.t.empty()) {
+      const double d = e.theta - last;
+      if (d > M_PI / 4) unwrap -= M_PI / 2;
+      if (d < -M_PI / 4) unwrap += M_PI / 2;
+    }
+    last = e.theta;
+    p.t.push_back(record.t_s[i]);
+    p.th.push_back(e.theta + unwrap);
+    p.rs.push_back(e.r);
+    p.ks.push_back(e.k);
+  }
+  return p;
+}
+
+/// The angle theta covers over the run; InputError when the samples are too few for `n_bins` or
+/// the coverage is under 3/4 of the period.
+double checkedCoverage(const SlowRecord& record, const PatternTrack& p, int n_bins) {
+  if (p.t.size() < static_cast<size_t>(kMinSamplesPerBin * n_bins))
+    throw InputError(record.source + ": too few samples with a pattern angle for " +
+                     std::to_string(n_bins) + " theta bins");
+  const double covered =
+      *std::max_element(p.th.begin(), p.th.end()) - *std::min_element(p.th.begin(), p.th.end());
+  if (covered < kMinCoveredFraction * M_PI / 2)
+    throw InputError(
+        record.source + ": the pattern angle covers " + std::to_string(covered * 180 / M_PI) +
+        " deg, under 3/4 of its period (90 deg): walk it further to measure theta'(theta)");
+  return covered;
+}
+
+/// The `n` bins of one period of theta, [-pi/4, pi/4).
+struct ThetaBins {
+  int n;
+  double width;
+  int of(double theta) const {
+    const double w = std::remainder(theta, M_PI / 2);  // [-pi/4, pi/4]
+    return std::min(n - 1, static_cast<int>(std::floor((w + M_PI / 4) / width)));
+  }
+};
+
+/// Samples are assigned to bins by a centred moving average of theta, not by their own noisy
+/// value: selecting a pass's samples by the value they are fitted on keeps those pushed into the
+/// bin by noise and drops those pushed out, which biases every slope low by a fraction of the
+/// whole rate (walk included; quartz at k0 = 0.1: 2-3 of a pass's interval). The window is about
+/// a quarter of a pass (2 .. 50 samples each side): its half-width.
+int halfWindow(double covered, double width, size_t n_samples) {
+  const double crossings = std::max(1.0, covered / width);
+  return std::clamp(static_cast<int>(kHalfWindowFraction * n_samples / crossings), kMinHalfWindow,
+                    kMaxHalfWindow);
+}
+
+/// The centred moving average of `th` over up to `half` samples each side (the selection angle).
+std::vector<double> selectionAngle(const std::vector<double>& th, int half) {
+  std::vector<double> sel(th.size());
+  for (size_t i = 0; i < th.size(); ++i) {
+    const size_t lo = i >= static_cast<size_t>(half) ? i - half : 0;
+    const size_t hi = std::min(th.size() - 1, i + half);
+    const size_t w = std::min(i - lo, hi - i);  // symmetric: unbiased on a straight path
+    double sum = 0.0;
+    for (size_t j = i - w; j <= i + w; ++j) sum += th[j];
+    sel[i] = sum / static_cast<double>(2 * w + 1);
+  }
+  return sel;
+}
+
+// Each pass through a bin: the least-squares slope of theta(t) over it. Its standard error
+// comes from the noise pooled over all passes (residual variance with sum(n - 2) dof, lag-1
+// correlation as an AR(1) long-run factor), not from each pass alone: a pass of ~10 samples
+// (quartz at k0 = 0.1) gave a HAC variance so noisy that the truth lay 2-3 of its intervals
+// away in one bin of four (issue #26).
+struct Pass {
+  int bin;
+  double slope, sxx;
+};
+
+/// The passes of a run, the samples per bin, and the noise sums pooled over the passes.
+struct PassSet {
+  std::vector<Pass> passes;
+  std::vector<int> samples;
+  double sse = 0.0, lag1 = 0.0;
+  long noise_dof = 0;
+};
+
+/// One pass, samples [start, end) in bin `b`: its slope of theta(t) less the walk into `set`, its
+/// residuals into the pooled noise sums.
+void fitPass(const PatternTrack& p, size_t start, size_t end, int b, double walk_rad_s,
+             PassSet* set) {
+  const int n = static_cast<int>(end - start);
+  double tm = 0.0, ym = 0.0;
+  for (size_t j = start; j < end; ++j) tm += p.t[j], ym += p.th[j];
+  tm /= n;
+  ym /= n;
+  double sxx = 0.0, sxy = 0.0;
+  for (size_t j = start; j < end; ++j) {
+    sxx += (p.t[j] - tm) * (p.t[j] - tm);
+    sxy += (p.t[j] - tm) * (p.th[j] - ym);
+  }
+  const double slope = sxy / sxx;
+  double prev = 0.0;
+  for (size_t j = start; j < end; ++j) {
+    const double e = p.th[j] - ym - slope * (p.t[j] - tm);
+    set->sse += e * e;
+    if (j > start) set->lag1 += e * prev;
+    prev = e;
+  }
+  set->noise_dof += n - 2;
+  set->passes.push_back({b, slope - walk_rad_s, sxx});
+}
+
+/// Cuts the run into runs of consecutive samples whose selection angle lies in one bin; those
+/// that count as passes are fitted.
+PassSet measurePasses(const PatternTrack& p, const std::vector<double>& sel, const ThetaBins& bins,
+                      double walk_rad_s) {
+  PassSet set;
+  set.samples.assign(bins.n, 0);
+  size_t start = 0;
+  for (size_t i = 1; i <= p.t.size(); ++i) {
+    if (i < p.t.size() && bins.of(sel[i]) == bins.of(sel[start])) continue;
+    const int b = bins.of(sel[start]);
+    set.samples[b] += static_cast<int>(i - start);
+    // A pass counts when it crosses at least half the bin (fragments at the record's ends and
+    // noise-driven re-entries would give slopes of a few samples).
+    const double travel = std::abs(sel[i - 1] - sel[start]);
+    if (i - start >= kMinPassSamples && travel >= kMinPassTravel * bins.width)
+      fitPass(p, start, i, b, walk_rad_s, &set);
+    start = i;
+  }
+  return set;
+}
+
+/// The noise pooled over the passes: variance, lag-1 correlation, its AR(1) long-run factor.
+struct PooledNoise {
+  double s2 = 0.0, rho = 0.0, long_run = 1.0;
+  double varianceOf(const Pass& p) const {
+    return std::max(s2 * long_run * long_run / p.sxx, kMinPassVariance);
+  }
+};
+
+PooledNoise poolNoise(const PassSet& set) {
+  PooledNoise noise;
+  noise.s2 = set.noise_dof > 0 ? set.sse / static_cast<double>(set.noise_dof) : 0.0;
+  noise.rho = set.sse > 0.0 ? std::clamp(set.lag1 / set.sse, 0.0, kMaxNoiseLag1) : 0.0;
+  noise.long_run = std::sqrt((1.0 + noise.rho) / (1.0 - noise.rho));
+  return noise;
+}
+
+/// Per bin: the inverse-variance mean of its passes, the sum of their weights, their count.
+struct BinMeans {
+  std::vector<double> weight, mean;
+  std::vector<int> count;
+};
+
+BinMeans meanPerBin(const PassSet& set, const PooledNoise& noise, int n_bins) {
+  BinMeans m;
+  m.weight.assign(n_bins, 0.0);
+  m.mean.assign(n_bins, 0.0);
+  m.count.assign(n_bins, 0);
+  for (const Pass& p : set.passes) {
+    m.weight[p.bin] += 1.0 / noise.varianceOf(p);
+    m.mean[p.bin] += p.slope / noise.varianceOf(p);
+    m.count[p.bin] += 1;
+  }
+  for (int b = 0; b < n_bins; ++b)
+    if (m.count[b] > 0) m.mean[b] /= m.weight[b];
+  return m;
+}
+
+/// Passes through one bin measure the same theta': their scatter about the bin means, pooled,
+/// checks the noise model; where they scatter more (slow noise, a wandering base), every
+/// interval is widened by that ratio, with Student's quantile at its dof. Sets the noise and
+/// scatter fields of `out`; returns the intervals' quantile.
+double scatterQuantile(const PassSet& set, const PooledNoise& noise, const BinMeans& m, int n_bins,
+                       double confidence, DriftComparison* out) {
+  double chi2 = 0.0;
+  int scatter_dof = 0;
+  for (const Pass& p : set.passes)
+    chi2 += (p.slope - m.mean[p.bin]) * (p.slope - m.mean[p.bin]) / noise.varianceOf(p);
+  for (int b = 0; b < n_bins; ++b) scatter_dof += std::max(0, m.count[b] - 1);
+  out->pass_scatter_ratio = scatter_dof > 0 ? std::max(1.0, std::sqrt(chi2 / scatter_dof)) : 1.0;
+  out->pass_scatter_dof = scatter_dof;
+  out->noise_dof = set.noise_dof;
+  out->noise_lag1 = noise.rho;
+  return out->pass_scatter_ratio > 1.0
+             ? studentQuantile(confidence, scatter_dof)
+             : studentQuantile(confidence,
+                               static_cast<int>(std::min<long>(set.noise_dof, kMaxQuantileDof)));
+}
+
+/// The measured bins' centres, measured and predicted drift, and their difference.
+struct BinSeries {
+  std::vector<double> centres, meas, pred, diff;
+};
+
+/// Every bin's measured theta' (with its interval) and its prediction, into out->bins.
+BinSeries compareBins(const ResonatorModel& model, const ThetaBins& bins, const PassSet& set,
+                      const BinMeans& m, double quantile, double walk_rad_s,
+                      const UncertainParameters& params, DriftComparison* out) {
+  BinSeries s;
+  for (int b = 0; b < bins.n; ++b) {
+    DriftBin bin;
+    bin.theta_rad = -M_PI / 4 + (b + 0.5) * bins.width;
+    bin.samples = set.samples[b];
+    bin.passes = m.count[b];
+    if (m.count[b] > 0) {
+      bin.measured.value = m.mean[b];
+      bin.measured.std_error = std::sqrt(1.0 / m.weight[b]) * out->pass_scatter_ratio;
+      bin.measured.ci_low = m.mean[b] - quantile * bin.measured.std_error;
+      bin.measured.ci_high = m.mean[b] + quantile * bin.measured.std_error;
+      bin.measured_ok = true;
+    }
+    bin.predicted =
+        binDriftWithInterval(model, out->r, out->k, bin.theta_rad, bins.width, walk_rad_s, params);
+    if (bin.measured_ok) {
+      s.centres.push_back(bin.theta_rad);
+      s.meas.push_back(bin.measured.value);
+      s.pred.push_back(bin.predicted.value);
+      s.diff.push_back(bin.measured.value - bin.predicted.value);
+    }
+    out->bins.push_back(bin);
+  }
+  return s;
+}
+
+/// The RMS of the measured drift and of measured - predicted, the harmonics of each, the summary.
+void summarize(const BinSeries& s, int n_bins, double walk_rad_s, DriftComparison* out) {
+  double s_d = 0, s_m = 0;
+  for (size_t i = 0; i < s.diff.size(); ++i) {
+    s_d += s.diff[i] * s.diff[i];
+    s_m += s.meas[i] * s.meas[i];
+  }
+  out->rms_difference_rad_s = std::sqrt(s_d / s.diff.size());
+  out->rms_measured_rad_s = std::sqrt(s_m / s.meas.size());
+  out->measured_harmonics = fitDriftHarmonics(s.centres, s.meas);
+  out->predicted_harmonics = fitDriftHarmonics(s.centres, s.pred);
+  out->residual_harmonics = fitDriftHarmonics(s.centres, s.diff);
+  const double dh = kDegPerHourPerRadPerSec;
+  std::ostringstream o;
+  o.precision(4);
+  o << "drift measured in " << out->bins_measured << " of " << n_bins << " theta bins (r " << out->r
+    << ", k " << out->k << ", walk " << walk_rad_s * dh << " deg/h subtracted): RMS "
+    << out->rms_measured_rad_s * dh << " deg/h uncompensated; predicted by " << out->model
+    << ": RMS of measured - predicted " << out->rms_difference_rad_s * dh
+    << " deg/h (the residual drift after compensation), "
+    << (out->rms_difference_rad_s > 0 ? out->rms_measured_rad_s / out->rms_difference_rad_s : 0.0)
+    << "x less";
+  out->summary = o.str();
+}
+
 }  // namespace
 
 DriftHarmonics fitDriftHarmonics(const std::vector<double>& theta, const std::vector<double>& y) {
@@ -73,184 +360,30 @@ DriftHarmonics fitDriftHarmonics(const std::vector<double>& theta, const std::ve
 
 DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
                              const UncertainParameters& params, int n_bins, double confidence) {
-  if (n_bins < 4 || n_bins > 3600) throw InputError("drift --measured: 4 .. 3600 theta bins");
-  std::vector<double> t, th, rs, ks;
-  double unwrap = 0.0, last = 0.0;
-  for (size_t i = 0; i < record.size(); ++i) {
-    const OrbitElements e = orbitFromSlow(record.q[i]);
-    if (!(e.r > 0.0) || e.r * e.r - e.k * e.k < 1e-4 * e.r * e.r) continue;
-    if (!t.empty()) {
-      const double d = e.theta - last;
-      if (d > M_PI / 4) unwrap -= M_PI / 2;
-      if (d < -M_PI / 4) unwrap += M_PI / 2;
-    }
-    last = e.theta;
-    t.push_back(record.t_s[i]);
-    th.push_back(e.theta + unwrap);
-    rs.push_back(e.r);
-    ks.push_back(e.k);
-  }
-  if (t.size() < static_cast<size_t>(4 * n_bins))
-    throw InputError(record.source + ": too few samples with a pattern angle for " +
-                     std::to_string(n_bins) + " theta bins");
-  const double covered =
-      *std::max_element(th.begin(), th.end()) - *std::min_element(th.begin(), th.end());
-  if (covered < 0.75 * M_PI / 2)
-    throw InputError(
-        record.source + ": the pattern angle covers " + std::to_string(covered * 180 / M_PI) +
-        " deg, under 3/4 of its period (90 deg): walk it further to measure theta'(theta)");
+  if (n_bins < kMinBins || n_bins > kMaxBins)
+    throw InputError("drift --measured: 4 .. 3600 theta bins");
+  const PatternTrack track = trackPatternAngle(record);
+  const double covered = checkedCoverage(record, track, n_bins);
   DriftComparison out;
   out.walk_rad_s = walk_rad_s;
-  out.r = median(rs);
-  out.k = median(ks);
-  const double width = (M_PI / 2) / n_bins;
-  auto binOf = [&](double theta) {
-    const double w = std::remainder(theta, M_PI / 2);  // [-pi/4, pi/4]
-    return std::min(n_bins - 1, static_cast<int>(std::floor((w + M_PI / 4) / width)));
-  };
-  // Each pass through a bin: the least-squares slope of theta(t) over it. Its standard error
-  // comes from the noise pooled over all passes (residual variance with sum(n - 2) dof, lag-1
-  // correlation as an AR(1) long-run factor), not from each pass alone: a pass of ~10 samples
-  // (quartz at k0 = 0.1) gave a HAC variance so noisy that the truth lay 2-3 of its intervals
-  // away in one bin of four (issue #26).
-  struct Pass {
-    int bin;
-    double slope, sxx;
-  };
-  std::vector<Pass> passes;
-  std::vector<int> samples(n_bins, 0);
-  double sse = 0.0, lag1 = 0.0;
-  long noise_dof = 0;
-  // Samples are assigned to bins by a centred moving average of theta, not by their own noisy
-  // value: selecting a pass's samples by the value they are fitted on keeps those pushed into the
-  // bin by noise and drops those pushed out, which biases every slope low by a fraction of the
-  // whole rate (walk included; quartz at k0 = 0.1: 2-3 of a pass's interval). The window is about
-  // a quarter of a pass (2 .. 50 samples each side).
-  const double crossings = std::max(1.0, covered / width);
-  const int half = std::clamp(static_cast<int>(0.125 * t.size() / crossings), 2, 50);
-  std::vector<double> sel(th.size());
-  for (size_t i = 0; i < th.size(); ++i) {
-    const size_t lo = i >= static_cast<size_t>(half) ? i - half : 0;
-    const size_t hi = std::min(th.size() - 1, i + half);
-    const size_t w = std::min(i - lo, hi - i);  // symmetric: unbiased on a straight path
-    double sum = 0.0;
-    for (size_t j = i - w; j <= i + w; ++j) sum += th[j];
-    sel[i] = sum / static_cast<double>(2 * w + 1);
-  }
-  size_t start = 0;
-  for (size_t i = 1; i <= t.size(); ++i) {
-    if (i < t.size() && binOf(sel[i]) == binOf(sel[start])) continue;
-    const int b = binOf(sel[start]);
-    samples[b] += static_cast<int>(i - start);
-    // A pass counts when it crosses at least half the bin (fragments at the record's ends and
-    // noise-driven re-entries would give slopes of a few samples).
-    const double travel = std::abs(sel[i - 1] - sel[start]);
-    if (i - start >= 6 && travel >= 0.5 * width) {
-      const int n = static_cast<int>(i - start);
-      double tm = 0.0, ym = 0.0;
-      for (size_t j = start; j < i; ++j) tm += t[j], ym += th[j];
-      tm /= n;
-      ym /= n;
-      double sxx = 0.0, sxy = 0.0;
-      for (size_t j = start; j < i; ++j) {
-        sxx += (t[j] - tm) * (t[j] - tm);
-        sxy += (t[j] - tm) * (th[j] - ym);
-      }
-      const double slope = sxy / sxx;
-      double prev = 0.0;
-      for (size_t j = start; j < i; ++j) {
-        const double e = th[j] - ym - slope * (t[j] - tm);
-        sse += e * e;
-        if (j > start) lag1 += e * prev;
-        prev = e;
-      }
-      noise_dof += n - 2;
-      passes.push_back({b, slope - walk_rad_s, sxx});
-    }
-    start = i;
-  }
-  const double s2 = noise_dof > 0 ? sse / static_cast<double>(noise_dof) : 0.0;
-  const double rho = sse > 0.0 ? std::clamp(lag1 / sse, 0.0, 0.9) : 0.0;
-  const double long_run = std::sqrt((1.0 + rho) / (1.0 - rho));
-  std::vector<double> weight(n_bins, 0.0), mean(n_bins, 0.0);
-  std::vector<int> count(n_bins, 0);
-  auto varianceOf = [&](const Pass& p) {
-    return std::max(s2 * long_run * long_run / p.sxx, 1e-300);
-  };
-  for (const Pass& p : passes) {
-    weight[p.bin] += 1.0 / varianceOf(p);
-    mean[p.bin] += p.slope / varianceOf(p);
-    count[p.bin] += 1;
-  }
-  for (int b = 0; b < n_bins; ++b)
-    if (count[b] > 0) mean[b] /= weight[b];
-  // Passes through one bin measure the same theta': their scatter about the bin means, pooled,
-  // checks the noise model; where they scatter more (slow noise, a wandering base), every
-  // interval is widened by that ratio, with Student's quantile at its dof.
-  double chi2 = 0.0;
-  int scatter_dof = 0;
-  for (const Pass& p : passes)
-    chi2 += (p.slope - mean[p.bin]) * (p.slope - mean[p.bin]) / varianceOf(p);
-  for (int b = 0; b < n_bins; ++b) scatter_dof += std::max(0, count[b] - 1);
-  out.pass_scatter_ratio = scatter_dof > 0 ? std::max(1.0, std::sqrt(chi2 / scatter_dof)) : 1.0;
-  out.pass_scatter_dof = scatter_dof;
-  out.noise_dof = noise_dof;
-  out.noise_lag1 = rho;
-  const double quantile =
-      out.pass_scatter_ratio > 1.0
-          ? studentQuantile(confidence, scatter_dof)
-          : studentQuantile(confidence, static_cast<int>(std::min<long>(noise_dof, 100000)));
+  out.r = median(track.rs);
+  out.k = median(track.ks);
+  const ThetaBins bins{n_bins, (M_PI / 2) / n_bins};
+  const std::vector<double> sel =
+      selectionAngle(track.th, halfWindow(covered, bins.width, track.t.size()));
+  const PassSet set = measurePasses(track, sel, bins, walk_rad_s);
+  const PooledNoise noise = poolNoise(set);
+  const BinMeans means = meanPerBin(set, noise, n_bins);
+  const double quantile = scatterQuantile(set, noise, means, n_bins, confidence, &out);
   const ResonatorModel model = freeOscillationModelOf(params.values);
   out.model = model.spec();
-  std::vector<double> centres, meas, pred, diff;
-  for (int b = 0; b < n_bins; ++b) {
-    DriftBin bin;
-    bin.theta_rad = -M_PI / 4 + (b + 0.5) * width;
-    bin.samples = samples[b];
-    bin.passes = count[b];
-    if (count[b] > 0) {
-      bin.measured.value = mean[b];
-      bin.measured.std_error = std::sqrt(1.0 / weight[b]) * out.pass_scatter_ratio;
-      bin.measured.ci_low = mean[b] - quantile * bin.measured.std_error;
-      bin.measured.ci_high = mean[b] + quantile * bin.measured.std_error;
-      bin.measured_ok = true;
-    }
-    bin.predicted =
-        binDriftWithInterval(model, out.r, out.k, bin.theta_rad, width, walk_rad_s, params);
-    if (bin.measured_ok) {
-      centres.push_back(bin.theta_rad);
-      meas.push_back(bin.measured.value);
-      pred.push_back(bin.predicted.value);
-      diff.push_back(bin.measured.value - bin.predicted.value);
-    }
-    out.bins.push_back(bin);
-  }
-  out.bins_measured = static_cast<int>(centres.size());
+  const BinSeries series = compareBins(model, bins, set, means, quantile, walk_rad_s, params, &out);
+  out.bins_measured = static_cast<int>(series.centres.size());
   if (out.bins_measured < n_bins / 2)
     throw InputError(record.source + ": only " + std::to_string(out.bins_measured) + " of " +
                      std::to_string(n_bins) +
                      " theta bins have a pass of 6 samples or more (sample faster or walk slower)");
-  double s_d = 0, s_m = 0;
-  for (size_t i = 0; i < diff.size(); ++i) {
-    s_d += diff[i] * diff[i];
-    s_m += meas[i] * meas[i];
-  }
-  out.rms_difference_rad_s = std::sqrt(s_d / diff.size());
-  out.rms_measured_rad_s = std::sqrt(s_m / meas.size());
-  out.measured_harmonics = fitDriftHarmonics(centres, meas);
-  out.predicted_harmonics = fitDriftHarmonics(centres, pred);
-  out.residual_harmonics = fitDriftHarmonics(centres, diff);
-  const double dh = 180.0 / M_PI * 3600.0;
-  std::ostringstream s;
-  s.precision(4);
-  s << "drift measured in " << out.bins_measured << " of " << n_bins << " theta bins (r " << out.r
-    << ", k " << out.k << ", walk " << walk_rad_s * dh << " deg/h subtracted): RMS "
-    << out.rms_measured_rad_s * dh << " deg/h uncompensated; predicted by " << out.model
-    << ": RMS of measured - predicted " << out.rms_difference_rad_s * dh
-    << " deg/h (the residual drift after compensation), "
-    << (out.rms_difference_rad_s > 0 ? out.rms_measured_rad_s / out.rms_difference_rad_s : 0.0)
-    << "x less";
-  out.summary = s.str();
+  summarize(series, n_bins, walk_rad_s, &out);
   return out;
 }
 

@@ -45,6 +45,12 @@ namespace {
 
 using Terms = std::vector<std::string>;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Residuals per block (equation error) or per sample (output error, q has 4 components): the
+/// channels of longRunVarianceFactor.
+constexpr int kResidualChannels = 4;
+/// Finalists whose output-error fit failed are replaced by further subsets in LS order: at most
+/// this many times `finalists` subsets are tried.
+constexpr int kMaxTriedPerFinalist = 2;
 
 double ratio(double a, double b) {
   if (!(b > 0.0)) return a > 0.0 ? kInf : 1.0;
@@ -330,180 +336,340 @@ std::string num(double v) {
   return s.str();
 }
 
-}  // namespace
-
-SelectionResult selectExtensions(const NestedModelFitter& fitter,
-                                 const std::vector<CandidateExtension>& candidates,
-                                 const SelectionOptions& options, std::vector<std::string>* notes) {
+/// Every problem with the options, in one InputError.
+void throwIfInvalid(const SelectionOptions& options) {
   const auto problems = options.validate();
   if (!problems.empty()) {
     std::string msg = "invalid selection options:";
     for (const auto& p : problems) msg += " " + p + ";";
     throw InputError(msg);
   }
-  SubsetSearch search(fitter, candidates, options, notes);
-  SelectionResult result;
-  result.holdout_description = fitter.holdoutDescription();
-  const NestedFit* base_cheap = search.cheap({});
-  if (!base_cheap) throw AnalysisError("explain: the linear model cannot be fitted");
+}
+
+/// One selection: its steps (the header comment of this file) and the state they pass on.
+class SelectionRun {
+ public:
+  /// Fits the linear model cheaply (AnalysisError when it cannot be fitted).
+  SelectionRun(const NestedModelFitter& fitter, const std::vector<CandidateExtension>& candidates,
+               const SelectionOptions& options, std::vector<std::string>* notes)
+      : fitter_(fitter),
+        options_(options),
+        notes_(notes),
+        search_(fitter, candidates, options, notes) {
+    result_.holdout_description = fitter.holdoutDescription();
+    base_cheap_ = search_.cheap({});
+    if (!base_cheap_) throw AnalysisError("explain: the linear model cannot be fitted");
+  }
 
   // 1. Cheap scores of every subset; c from the whole library's cheap fit (least misfit).
-  const std::vector<Terms> all = subsetsUpTo(search.names(), options.max_steps);
-  const NestedFit* widest = search.cheap(search.names());
-  for (const auto& t : all) search.cheap(t);
-  if (!widest) {
-    for (const auto& t : all) {
-      const NestedFit* f = search.cheap(t);
-      if (f && (!widest || t.size() > widest->extensions.size() ||
-                (t.size() == widest->extensions.size() && f->rss < widest->rss)))
-        widest = f;
+  void scoreCheap() {
+    all_ = subsetsUpTo(search_.names(), options_.max_steps);
+    const NestedFit* widest = widestCheapFit();
+    result_.correlation_factor_ls = longRunVarianceFactor(
+        widest->scored_residuals.size() ? widest->scored_residuals : widest->residuals,
+        kResidualChannels);
+    c_ls_ = result_.correlation_factor_ls;
+    for (const auto& t : all_) {
+      const NestedFit* f = search_.cheap(t);
+      if (!f) continue;
+      SubsetScore s;
+      s.terms = t;
+      s.model = key(t);
+      s.criterion_ls = search_.criterion(*f, t.size(), c_ls_);
+      s.criterion = s.criterion_ls;
+      s.sigma = f->sigma;
+      scores_.push_back(s);
     }
+    std::stable_sort(
+        scores_.begin(), scores_.end(),
+        [](const SubsetScore& a, const SubsetScore& b) { return a.criterion_ls < b.criterion_ls; });
   }
-  result.correlation_factor_ls = longRunVarianceFactor(
-      widest->scored_residuals.size() ? widest->scored_residuals : widest->residuals, 4);
-  const double c_ls = result.correlation_factor_ls;
-  std::vector<SubsetScore> scores;
-  for (const auto& t : all) {
-    const NestedFit* f = search.cheap(t);
-    if (!f) continue;
-    SubsetScore s;
-    s.terms = t;
-    s.model = key(t);
-    s.criterion_ls = search.criterion(*f, t.size(), c_ls);
-    s.criterion = s.criterion_ls;
-    s.sigma = f->sigma;
-    scores.push_back(s);
-  }
-  std::stable_sort(scores.begin(), scores.end(), [](const SubsetScore& a, const SubsetScore& b) {
-    return a.criterion_ls < b.criterion_ls;
-  });
 
   // 2. Refine the linear model and the finalists.
-  std::vector<Terms> finalists = {{}};
-  for (const auto& s : scores)
-    if (!s.terms.empty() && static_cast<int>(finalists.size()) <= options.finalists)
-      finalists.push_back(s.terms);
-  search.refineAll(finalists);  // the linear model first: the order refined() would be called in
-  const NestedFit* base = search.refined({});
-  const bool refined_scale =
-      fitter.refinesByOutputError() && base != nullptr && base->estimate.method == "ceres";
-  if (fitter.refinesByOutputError() && !base && notes)
-    notes->push_back("the linear model's output-error fit failed: subsets compared on LS alone");
-  double c = c_ls;
-  auto fitOf = [&](const Terms& t) { return search.refined(t); };
-  if (refined_scale) {
-    // The largest finalist whose trajectory exists over the record (a fit that diverged has no
-    // output-error residuals; the linear model at worst).
+  void refineFinalists() {
+    std::vector<Terms> finalists = {{}};
+    for (const auto& s : scores_)
+      if (!s.terms.empty() && static_cast<int>(finalists.size()) <= options_.finalists)
+        finalists.push_back(s.terms);
+    search_.refineAll(finalists);  // the linear model first: the order refined() would be called in
+    const NestedFit* base = search_.refined({});
+    refined_scale_ =
+        fitter_.refinesByOutputError() && base != nullptr && base->estimate.method == "ceres";
+    if (fitter_.refinesByOutputError() && !base && notes_)
+      notes_->push_back("the linear model's output-error fit failed: subsets compared on LS alone");
+    c_ = c_ls_;
+    if (refined_scale_) c_ = refinedCorrelationFactor(finalists);
+    result_.correlation_factor = c_;
+    scoreFinalists(finalists);
+  }
+
+  // Refined neighbours: the LS ranking of (2.8) can miss a subset whose terms act together (its
+  // errors-in-variables bias hides small terms), so every one-term extension of the best refined
+  // subset is refined too, until none scores better.
+  void refineNeighbours() {
+    for (int round = 0; round < options_.max_steps; ++round) {
+      const auto r = ranked();
+      if (r.empty()) break;
+      const Terms best = r.front().second;
+      const double best_v = r.front().first;
+      bool improved = false;
+      std::vector<Terms> extensions;
+      for (const auto& name : search_.names()) {
+        if (std::find(best.begin(), best.end(), name) != best.end()) continue;
+        Terms t = best;
+        t.push_back(name);
+        t = search_.canonical(t);
+        if (static_cast<int>(t.size()) > options_.max_steps || crit_.count(key(t))) continue;
+        extensions.push_back(t);
+      }
+      // Started from the best subset's refined fit.
+      search_.refineAll(extensions, search_.refined(best));
+      for (const auto& t : extensions)
+        if (score(t) < best_v) improved = true;
+      if (!improved) break;
+    }
+  }
+
+  // 3. Best refined subset, backward check, hold-out confirmation.
+  void choose() {
+    const double base_crit = score({});
+    for (;;) {
+      Terms top;
+      if (!nextUnrejected(&top) || top.empty() || !(score(top) < base_crit)) break;
+      rejected_keys_.push_back(key(top));  // each round retires its pick: the loop ends
+      const Terms best = backwardCheck(top);
+      if (best.empty()) break;
+      if (best != top && rejected(best)) continue;
+      if (best != top) rejected_keys_.push_back(key(best));
+      if (confirmedOnHoldout(best)) {
+        chosen_ = best;
+        break;
+      }
+    }
+    result_.dropped.erase(std::remove_if(result_.dropped.begin(), result_.dropped.end(),
+                                         [&](const std::string& n) {
+                                           return std::find(chosen_.begin(), chosen_.end(), n) !=
+                                                  chosen_.end();
+                                         }),
+                          result_.dropped.end());
+  }
+
+  // 4. Steps ladder, runner-up, subset table. The fits reported get their intervals: the
+  // baseline, the chosen subset and its refined one-term extensions (at once), the ladder's.
+  void completeReported() {
+    const Terms chosen_sorted = search_.canonical(chosen_);
+    std::vector<Terms> reported = {{}, chosen_sorted};
+    for (const auto& name : search_.names()) {
+      Terms t = chosen_sorted;
+      if (std::find(t.begin(), t.end(), name) != t.end()) continue;
+      t.push_back(name);
+      t = search_.canonical(t);
+      if (crit_.count(key(t))) reported.push_back(t);
+    }
+    search_.completeAll(reported);
+  }
+
+  /// The steps ladder: the chosen terms added one at a time, best refined criterion first; the
+  /// baseline, the selected terms and the final fit.
+  void climbLadder() {
+    const NestedFit* prev = search_.complete({});
+    if (!prev) prev = base_cheap_;
+    result_.baseline = *prev;
+    Terms prefix;
+    while (prefix.size() < chosen_.size()) {
+      double best_v = kInf;
+      const std::string add = nextRung(prefix, &best_v);
+      Terms next = prefix;
+      next.push_back(add);
+      const NestedFit* f = search_.complete(search_.canonical(next));
+      if (!f) break;
+      SelectionStep s = stepOver(*prev, *f, add);
+      search_.holdoutAll({search_.canonical(prefix), search_.canonical(next)});
+      s.holdout_ratio = ratio(search_.holdout(search_.canonical(prefix)),
+                              search_.holdout(search_.canonical(next)));
+      s.delta_criterion = best_v - score(search_.canonical(prefix));
+      s.accepted = true;
+      result_.steps.push_back(s);
+      prefix = next;
+      prev = f;
+    }
+    result_.selected = prefix;
+    result_.final_fit = *prev;
+    result_.final_fit.extensions = prefix;
+    final_ = prev;
+    chosen_c_ = search_.canonical(prefix);
+  }
+
+  /// Candidates one term beyond the chosen subset that were refined (the verdict's near misses).
+  void addNearMisses() {
+    for (const auto& name : search_.names()) {
+      if (std::find(chosen_c_.begin(), chosen_c_.end(), name) != chosen_c_.end()) continue;
+      Terms t = chosen_c_;
+      t.push_back(name);
+      t = search_.canonical(t);
+      if (!crit_.count(key(t)) || !std::isfinite(crit_[key(t)])) continue;
+      const NestedFit* f = search_.complete(t);
+      SelectionStep s = stepOver(*final_, *f, name);
+      s.delta_criterion = crit_[key(t)] - score(chosen_c_);
+      result_.last_round.push_back(s);
+    }
+  }
+
+  /// The subset table: the refined criterion and sigma where refined, the hold-out ratio where
+  /// computed.
+  void fillSubsetTable() {
+    for (auto& s : scores_) {
+      const std::string k = key(s.terms);
+      if (crit_.count(k)) {
+        s.refined = true;
+        s.criterion = crit_[k];
+        if (const NestedFit* f = search_.refined(s.terms)) s.sigma = f->sigma;
+      }
+      // Hold-out ratios only where they were computed (no extra fits for the table).
+      if (search_.hasHoldout(s.terms))
+        s.holdout_ratio = ratio(search_.holdout({}), search_.holdout(s.terms));
+    }
+    result_.subsets = scores_;
+  }
+
+  /// The chosen subset's row, and the runner-up: the best refined subset not chosen.
+  void pickRunnerUp() {
+    result_.chosen = scoreOf(chosen_c_);
+    double runner = kInf;
+    for (const auto& r : ranked()) {
+      if (key(r.second) == key(chosen_c_)) continue;
+      result_.runner_up = scoreOf(r.second);
+      runner = r.first;
+      break;
+    }
+    result_.runner_up_delta = std::isfinite(runner) ? runner - score(chosen_c_) : kInf;
+  }
+
+  /// The criterion in words.
+  void describeCriterion() {
+    std::ostringstream d;
+    d << "best subset of up to " << options_.max_steps << " of " << search_.names().size()
+      << " candidates by IC = n_eff ln(RSS/N) + k max(ln n_eff, " << num(search_.penaltyFloor())
+      << "), n_eff = N / c; ranked on the equation-error LS fit (c = " << num(c_ls_) << "), the "
+      << "linear model and " << options_.finalists << " finalists refined"
+      << (refined_scale_ ? " by the output-error fit (c = " + num(c_) + ")" : "")
+      << ", confirmed on the hold-out";
+    result_.criterion_description = d.str();
+  }
+
+  SelectionResult take() { return std::move(result_); }
+
+ private:
+  /// The whole library's cheap fit, else the widest cheap fit (the least RSS among equals); every
+  /// subset fitted cheaply on the way.
+  const NestedFit* widestCheapFit() {
+    const NestedFit* widest = search_.cheap(search_.names());
+    for (const auto& t : all_) search_.cheap(t);
+    if (!widest) {
+      for (const auto& t : all_) {
+        const NestedFit* f = search_.cheap(t);
+        if (f && (!widest || t.size() > widest->extensions.size() ||
+                  (t.size() == widest->extensions.size() && f->rss < widest->rss)))
+          widest = f;
+      }
+    }
+    return widest;
+  }
+
+  /// c of the refined fits: from the largest finalist whose trajectory exists over the record (a
+  /// fit that diverged has no output-error residuals; the linear model at worst), never below
+  /// that of the record's known noise correlation.
+  double refinedCorrelationFactor(const std::vector<Terms>& finalists) {
     std::vector<const NestedFit*> by_size;
     for (const auto& t : finalists)
-      if (const NestedFit* f = fitOf(t)) by_size.push_back(f);
+      if (const NestedFit* f = search_.refined(t)) by_size.push_back(f);
     std::stable_sort(by_size.begin(), by_size.end(), [](const NestedFit* a, const NestedFit* b) {
       return a->extensions.size() > b->extensions.size();
     });
     Eigen::VectorXd e;
     for (const NestedFit* f : by_size) {
       if (f->estimate.method != "ceres") continue;
-      e = adequacyVector(fitter, *f);
+      e = adequacyVector(fitter_, *f);
       if (e.size() > 0) break;
     }
-    c = std::max(e.size() > 0 ? longRunVarianceFactor(e, 4) : 1.0,
-                 longRunVarianceFactor(fitter.knownNoiseCorrelation()));
-  }
-  result.correlation_factor = c;
-  std::map<std::string, double> crit;
-  auto score = [&](const Terms& t) {
-    const std::string k = key(t);
-    const auto it = crit.find(k);
-    if (it != crit.end()) return it->second;
-    const NestedFit* f = fitOf(t);
-    // A free-decay refinement that fell back to LS has residuals in other units: not comparable
-    // unless a retry from a refined nested fit converges; said either way (notes).
-    if (f && refined_scale && f->estimate.method != "ceres") {
-      search.retryFallback(t);
-      f = fitOf(t);
-    }
-    const bool comparable = f && (!refined_scale || f->estimate.method == "ceres");
-    const double v = comparable ? search.criterion(*f, t.size(), c) : kInf;
-    crit[k] = v;
-    return v;
-  };
-  // A finalist whose output-error fit failed is not comparable: refine further subsets in LS order
-  // until `finalists` comparable ones exist (at most twice as many tried).
-  int comparable = 0;
-  for (const auto& t : finalists)
-    if (!t.empty() && std::isfinite(score(t))) ++comparable;
-  int tried = static_cast<int>(finalists.size()) - 1;
-  for (const auto& sc : scores) {
-    if (comparable >= options.finalists || tried >= 2 * options.finalists) break;
-    if (sc.terms.empty() || crit.count(key(sc.terms))) continue;
-    ++tried;
-    if (std::isfinite(score(sc.terms))) ++comparable;
+    return std::max(e.size() > 0 ? longRunVarianceFactor(e, kResidualChannels) : 1.0,
+                    longRunVarianceFactor(fitter_.knownNoiseCorrelation()));
   }
 
-  // 3. Best refined subset, backward check, hold-out confirmation.
-  auto ranked = [&]() {
+  /// A finalist whose output-error fit failed is not comparable: refine further subsets in LS
+  /// order until `finalists` comparable ones exist (at most twice as many tried).
+  void scoreFinalists(const std::vector<Terms>& finalists) {
+    int comparable = 0;
+    for (const auto& t : finalists)
+      if (!t.empty() && std::isfinite(score(t))) ++comparable;
+    int tried = static_cast<int>(finalists.size()) - 1;
+    for (const auto& sc : scores_) {
+      if (comparable >= options_.finalists || tried >= kMaxTriedPerFinalist * options_.finalists)
+        break;
+      if (sc.terms.empty() || crit_.count(key(sc.terms))) continue;
+      ++tried;
+      if (std::isfinite(score(sc.terms))) ++comparable;
+    }
+  }
+
+  /// The refined criterion of `t` (c_), computed once; kInf when not comparable.
+  double score(const Terms& t) {
+    const std::string k = key(t);
+    const auto it = crit_.find(k);
+    if (it != crit_.end()) return it->second;
+    const NestedFit* f = search_.refined(t);
+    // A free-decay refinement that fell back to LS has residuals in other units: not comparable
+    // unless a retry from a refined nested fit converges; said either way (notes).
+    if (f && refined_scale_ && f->estimate.method != "ceres") {
+      search_.retryFallback(t);
+      f = search_.refined(t);
+    }
+    const bool comparable = f && (!refined_scale_ || f->estimate.method == "ceres");
+    const double v = comparable ? search_.criterion(*f, t.size(), c_) : kInf;
+    crit_[k] = v;
+    return v;
+  }
+
+  /// The scored subsets with a finite criterion, best first.
+  std::vector<std::pair<double, Terms>> ranked() const {
     std::vector<std::pair<double, Terms>> r;
-    for (const auto& kv : crit) {
-      for (const auto& s : all)
+    for (const auto& kv : crit_) {
+      for (const auto& s : all_)
         if (key(s) == kv.first && std::isfinite(kv.second)) r.push_back({kv.second, s});
     }
     std::stable_sort(r.begin(), r.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
     return r;
-  };
-  // Refined neighbours: the LS ranking of (2.8) can miss a subset whose terms act together (its
-  // errors-in-variables bias hides small terms), so every one-term extension of the best refined
-  // subset is refined too, until none scores better.
-  for (int round = 0; round < options.max_steps; ++round) {
-    const auto r = ranked();
-    if (r.empty()) break;
-    const Terms best = r.front().second;
-    const double best_v = r.front().first;
-    bool improved = false;
-    std::vector<Terms> extensions;
-    for (const auto& name : search.names()) {
-      if (std::find(best.begin(), best.end(), name) != best.end()) continue;
-      Terms t = best;
-      t.push_back(name);
-      t = search.canonical(t);
-      if (static_cast<int>(t.size()) > options.max_steps || crit.count(key(t))) continue;
-      extensions.push_back(t);
-    }
-    search.refineAll(extensions, fitOf(best));  // started from the best subset's refined fit
-    for (const auto& t : extensions)
-      if (score(t) < best_v) improved = true;
-    if (!improved) break;
   }
-  const double base_crit = score({});
-  std::vector<std::string> rejected_keys;
-  Terms chosen;
-  auto rejected = [&](const Terms& t) {
-    return std::find(rejected_keys.begin(), rejected_keys.end(), key(t)) != rejected_keys.end();
-  };
-  auto drop = [&](const std::string& n) {
-    if (std::find(result.dropped.begin(), result.dropped.end(), n) == result.dropped.end())
-      result.dropped.push_back(n);
-  };
-  for (;;) {
-    Terms top;
-    bool found = false;
+
+  bool rejected(const Terms& t) const {
+    return std::find(rejected_keys_.begin(), rejected_keys_.end(), key(t)) != rejected_keys_.end();
+  }
+  void drop(const std::string& n) {
+    if (std::find(result_.dropped.begin(), result_.dropped.end(), n) == result_.dropped.end())
+      result_.dropped.push_back(n);
+  }
+
+  /// The best ranked subset not rejected yet into *top; false when there is none.
+  bool nextUnrejected(Terms* top) const {
     for (const auto& r : ranked()) {
       if (rejected(r.second)) continue;
-      top = r.second;
-      found = true;
-      break;
+      *top = r.second;
+      return true;
     }
-    if (!found || top.empty() || !(score(top) < base_crit)) break;
-    rejected_keys.push_back(key(top));  // each round retires its pick: the loop ends
-    // Backward check: a term goes when the subset without it scores better.
+    return false;
+  }
+
+  /// Backward check: a term goes when the subset without it scores better.
+  Terms backwardCheck(const Terms& top) {
     Terms best = top;
-    bool shrunk = options.backward_check;
+    bool shrunk = options_.backward_check;
     while (shrunk && !best.empty()) {
       shrunk = false;
       Terms better = best;
       std::vector<Terms> smaller_subsets;
       for (const auto& name : best) smaller_subsets.push_back(without(best, name));
-      search.refineAll(smaller_subsets);
+      search_.refineAll(smaller_subsets);
       for (const auto& name : best) {
         const Terms smaller = without(best, name);
         if (score(smaller) < score(better)) better = smaller;
@@ -511,157 +677,115 @@ SelectionResult selectExtensions(const NestedModelFitter& fitter,
       if (better != best) {
         for (const auto& n : best)
           if (std::find(better.begin(), better.end(), n) == better.end()) drop(n);
-        if (notes)
-          notes->push_back("backward check: " + key(best) + " -> " + key(better) + " (criterion " +
-                           num(score(best)) + " -> " + num(score(better)) + ")");
+        if (notes_)
+          notes_->push_back("backward check: " + key(best) + " -> " + key(better) + " (criterion " +
+                            num(score(best)) + " -> " + num(score(better)) + ")");
         best = better;
         shrunk = true;
       }
     }
-    if (best.empty()) break;
-    if (best != top && rejected(best)) continue;
-    if (best != top) rejected_keys.push_back(key(best));
-    search.holdoutAll({{}, best});
-    const double h = ratio(search.holdout({}), search.holdout(best));
-    if (h > options.min_holdout_ratio) {
-      chosen = best;
-      break;
-    }
+    return best;
+  }
+
+  /// Hold-out confirmation: `best` must predict the held-out data better than the linear model,
+  /// else its terms are dropped (said in the notes).
+  bool confirmedOnHoldout(const Terms& best) {
+    search_.holdoutAll({{}, best});
+    const double h = ratio(search_.holdout({}), search_.holdout(best));
+    if (h > options_.min_holdout_ratio) return true;
     for (const auto& n : best) drop(n);
-    if (notes)
-      notes->push_back("hold-out confirmation: " + key(best) +
-                       " (best criterion) predicts the held-out data no better than the linear "
-                       "model (ratio " +
-                       num(h) + "): not chosen");
+    if (notes_)
+      notes_->push_back("hold-out confirmation: " + key(best) +
+                        " (best criterion) predicts the held-out data no better than the linear "
+                        "model (ratio " +
+                        num(h) + "): not chosen");
+    return false;
   }
 
-  result.dropped.erase(std::remove_if(result.dropped.begin(), result.dropped.end(),
-                                      [&](const std::string& n) {
-                                        return std::find(chosen.begin(), chosen.end(), n) !=
-                                               chosen.end();
-                                      }),
-                       result.dropped.end());
-
-  // 4. Steps ladder, runner-up, subset table. The fits reported get their intervals: the
-  // baseline, the chosen subset and its refined one-term extensions (at once), the ladder's.
-  const Terms chosen_sorted = search.canonical(chosen);
-  std::vector<Terms> reported = {{}, chosen_sorted};
-  for (const auto& name : search.names()) {
-    Terms t = chosen_sorted;
-    if (std::find(t.begin(), t.end(), name) != t.end()) continue;
-    t.push_back(name);
-    t = search.canonical(t);
-    if (crit.count(key(t))) reported.push_back(t);
-  }
-  search.completeAll(reported);
-  const NestedFit* prev = search.complete({});
-  if (!prev) prev = base_cheap;
-  result.baseline = *prev;
-  Terms prefix;
-  while (prefix.size() < chosen.size()) {
+  /// The ladder's next term: of the chosen terms not in `prefix`, the one whose addition scores
+  /// best (its criterion into *best_v); those extensions refined at once first.
+  std::string nextRung(const Terms& prefix, double* best_v) {
     std::string add;
-    double best_v = kInf;
     std::vector<Terms> next_subsets;
-    for (const auto& n : chosen) {
+    for (const auto& n : chosen_) {
       if (std::find(prefix.begin(), prefix.end(), n) != prefix.end()) continue;
       Terms t = prefix;
       t.push_back(n);
-      next_subsets.push_back(search.canonical(t));
+      next_subsets.push_back(search_.canonical(t));
     }
-    search.refineAll(next_subsets);
-    for (const auto& n : chosen) {
+    search_.refineAll(next_subsets);
+    for (const auto& n : chosen_) {
       if (std::find(prefix.begin(), prefix.end(), n) != prefix.end()) continue;
       Terms t = prefix;
       t.push_back(n);
-      const double v = score(search.canonical(t));
-      if (add.empty() || v < best_v) add = n, best_v = v;
+      const double v = score(search_.canonical(t));
+      if (add.empty() || v < *best_v) add = n, *best_v = v;
     }
-    Terms next = prefix;
-    next.push_back(add);
-    const NestedFit* f = search.complete(search.canonical(next));
-    if (!f) break;
+    return add;
+  }
+
+  /// The step from `prev` to its extension `f` by `added`, with the gains of forward_selection.h.
+  SelectionStep stepOver(const NestedFit& prev, const NestedFit& f,
+                         const std::string& added) const {
     SelectionStep s;
-    s.added = add;
-    s.fit = *f;
-    s.model = f->model;
-    s.sigma = f->sigma;
-    s.sigma_ratio = ratio(prev->sigma, f->sigma);
-    s.wald = waldTest(f->estimate, {add});
+    s.added = added;
+    s.fit = f;
+    s.model = f.model;
+    s.sigma = f.sigma;
+    s.sigma_ratio = ratio(prev.sigma, f.sigma);
+    s.wald = waldTest(f.estimate, {added});
     s.delta_bic =
-        deltaBic(prev->rss, f->rss, f->n_equations, f->estimate.n_params - prev->estimate.n_params);
-    search.holdoutAll({search.canonical(prefix), search.canonical(next)});
-    s.holdout_ratio =
-        ratio(search.holdout(search.canonical(prefix)), search.holdout(search.canonical(next)));
-    s.delta_criterion = best_v - score(search.canonical(prefix));
-    s.threshold = options.alpha;
-    s.accepted = true;
-    result.steps.push_back(s);
-    prefix = next;
-    prev = f;
+        deltaBic(prev.rss, f.rss, f.n_equations, f.estimate.n_params - prev.estimate.n_params);
+    s.threshold = options_.alpha;
+    return s;
   }
-  result.selected = prefix;
-  result.final_fit = *prev;
-  result.final_fit.extensions = prefix;
-  const Terms chosen_c = search.canonical(prefix);
-  // Candidates one term beyond the chosen subset that were refined (the verdict's near misses).
-  for (const auto& name : search.names()) {
-    if (std::find(chosen_c.begin(), chosen_c.end(), name) != chosen_c.end()) continue;
-    Terms t = chosen_c;
-    t.push_back(name);
-    t = search.canonical(t);
-    if (!crit.count(key(t)) || !std::isfinite(crit[key(t)])) continue;
-    const NestedFit* f = search.complete(t);
-    SelectionStep s;
-    s.added = name;
-    s.fit = *f;
-    s.model = f->model;
-    s.sigma = f->sigma;
-    s.sigma_ratio = ratio(prev->sigma, f->sigma);
-    s.wald = waldTest(f->estimate, {name});
-    s.delta_bic =
-        deltaBic(prev->rss, f->rss, f->n_equations, f->estimate.n_params - prev->estimate.n_params);
-    s.delta_criterion = crit[key(t)] - score(chosen_c);
-    s.threshold = options.alpha;
-    result.last_round.push_back(s);
-  }
-  for (auto& s : scores) {
-    const std::string k = key(s.terms);
-    if (crit.count(k)) {
-      s.refined = true;
-      s.criterion = crit[k];
-      if (const NestedFit* f = fitOf(s.terms)) s.sigma = f->sigma;
-    }
-    // Hold-out ratios only where they were computed (no extra fits for the table).
-    if (search.hasHoldout(s.terms))
-      s.holdout_ratio = ratio(search.holdout({}), search.holdout(s.terms));
-  }
-  result.subsets = scores;
-  auto scoreOf = [&](const Terms& t) {
-    for (const auto& s : scores)
+
+  /// The row of `t` in the subset table (a bare row when it is not there).
+  SubsetScore scoreOf(const Terms& t) const {
+    for (const auto& s : scores_)
       if (key(s.terms) == key(t)) return s;
     SubsetScore s;
     s.terms = t;
     s.model = key(t);
     return s;
-  };
-  result.chosen = scoreOf(chosen_c);
-  double runner = kInf;
-  for (const auto& r : ranked()) {
-    if (key(r.second) == key(chosen_c)) continue;
-    result.runner_up = scoreOf(r.second);
-    runner = r.first;
-    break;
   }
-  result.runner_up_delta = std::isfinite(runner) ? runner - score(chosen_c) : kInf;
-  std::ostringstream d;
-  d << "best subset of up to " << options.max_steps << " of " << search.names().size()
-    << " candidates by IC = n_eff ln(RSS/N) + k max(ln n_eff, " << num(search.penaltyFloor())
-    << "), n_eff = N / c; ranked on the equation-error LS fit (c = " << num(c_ls) << "), the "
-    << "linear model and " << options.finalists << " finalists refined"
-    << (refined_scale ? " by the output-error fit (c = " + num(c) + ")" : "")
-    << ", confirmed on the hold-out";
-  result.criterion_description = d.str();
-  return result;
+
+  const NestedModelFitter& fitter_;
+  const SelectionOptions& options_;
+  std::vector<std::string>* notes_;
+  SubsetSearch search_;
+  SelectionResult result_;
+  const NestedFit* base_cheap_ = nullptr;  ///< the linear model's cheap fit
+  std::vector<Terms> all_;                 ///< every subset of up to max_steps candidates
+  double c_ls_ = 1.0;                      ///< c of the cheap fits
+  std::vector<SubsetScore> scores_;        ///< every subset fitted, best cheap criterion first
+  bool refined_scale_ = false;             ///< the refined fits are output-error fits
+  double c_ = 1.0;                         ///< c of the refined fits (c_ls_ without them)
+  std::map<std::string, double> crit_;     ///< refined criterion by subset key
+  std::vector<std::string> rejected_keys_;
+  Terms chosen_;                      ///< the confirmed subset (empty: the linear model)
+  const NestedFit* final_ = nullptr;  ///< the ladder's last fit
+  Terms chosen_c_;                    ///< the selected terms, candidate order
+};
+
+}  // namespace
+
+SelectionResult selectExtensions(const NestedModelFitter& fitter,
+                                 const std::vector<CandidateExtension>& candidates,
+                                 const SelectionOptions& options, std::vector<std::string>* notes) {
+  throwIfInvalid(options);
+  SelectionRun run(fitter, candidates, options, notes);
+  run.scoreCheap();        // 1. cheap scores of every subset
+  run.refineFinalists();   // 2. the linear model and the finalists refined
+  run.refineNeighbours();  //    their one-term extensions refined while they score better
+  run.choose();            // 3. best refined subset, backward check, hold-out confirmation
+  run.completeReported();  // 4. intervals of the fits reported,
+  run.climbLadder();       //    the steps ladder,
+  run.addNearMisses();     //    the near misses,
+  run.fillSubsetTable();   //    the subset table,
+  run.pickRunnerUp();      //    the runner-up,
+  run.describeCriterion();
+  return run.take();
 }
 
 }  // namespace cvg_bench
