@@ -16,7 +16,37 @@
 namespace cvg_bench {
 namespace {
 
+/// Filter orders tried: 1..kMaxOrder equal real poles.
 constexpr int kMaxOrder = 4;
+
+/// The span's last samples whose median gives the level at its end.
+constexpr size_t kEndLevelSamples = 9;
+/// The level above the floor at the span's end [dB] when none of those samples is usable.
+constexpr double kDefaultAboveFloorDb = 10.0;
+/// The floor stretch starts where the decay's straight continuation lies this far below the floor
+/// [dB].
+constexpr double kBelowFloorDb = 6.0;
+/// A floor stretch (and its valid samples) must number at least this many samples.
+constexpr int kMinFloorSamples = 120;
+/// Sampling is uniform when every interval is within this fraction of the median one.
+constexpr double kSamplingTolerance = 0.01;
+/// The autocorrelation is taken over at most this many lags, and over at most a kLagsDivisor-th of
+/// the stretch.
+constexpr size_t kMaxLags = 300;
+constexpr size_t kLagsDivisor = 4;
+/// The lags end where the autocorrelation falls under this (K of the header).
+constexpr double kCorrelationEnd = 0.05;
+/// Under this correlation at lag 1 the filter is shorter than the sample interval (negligible).
+constexpr double kMinLag1Correlation = 0.2;
+/// The log grid of T in samples: this many nodes from kGridMinSamples to kGridMaxSamples.
+constexpr int kGridNodes = 160;
+constexpr double kGridMinSamples = 0.05;
+constexpr double kGridMaxSamples = 400.0;
+/// Golden-section iterations between the best node's neighbours.
+constexpr int kGoldenIterations = 40;
+/// A floor stretch under this many filter lengths (n T) gives an autocorrelation too noisy to
+/// trust.
+constexpr double kMinFilterLengths = 8.0;
 
 double median(const std::vector<double>& v) {
   return sampleMedian(v);
@@ -55,6 +85,121 @@ double correlationMisfit(int order, double t_samples, const std::vector<double>&
   return s;
 }
 
+/// Step 1: the floor stretch's first sample.
+size_t floorStretchStart(const RingdownEnvelope& env, const RingdownSegment& seg,
+                         double decay_rate_1_s) {
+  const auto& t = env.t_s;
+  const auto& y = env.log_amplitude;
+  // Level at the span's end above the floor; the stretch starts 6 dB below the floor on the
+  // decay's straight continuation.
+  std::vector<double> last;
+  for (size_t i = seg.i_end > kEndLevelSamples ? seg.i_end - kEndLevelSamples : 0;
+       i < seg.i_end && i < y.size(); ++i)
+    if (!seg.dropout[i] && std::isfinite(y[i])) last.push_back(y[i]);
+  const double above =
+      last.empty() ? kDefaultAboveFloorDb / kDbPerNeper : median(last) - seg.floor_log_amplitude;
+  const double t_a = seg.t_end_s + (above + kBelowFloorDb / kDbPerNeper) / decay_rate_1_s;
+  size_t a = 0;
+  while (a < t.size() && t[a] < t_a) ++a;
+  return a;
+}
+
+/// The floor stretch's power re the floor, per sample of [a, a + m).
+struct FloorPower {
+  std::vector<double> p;    ///< less the fitted residual signal and mean (when nv is enough)
+  std::vector<bool> valid;  ///< not a drop-out, finite
+  int nv = 0;               ///< valid samples
+};
+
+/// Step 3 (the fit of c0 and c1 only with kMinFloorSamples valid samples or more).
+FloorPower floorPower(const RingdownEnvelope& env, const RingdownSegment& seg,
+                      double decay_rate_1_s, size_t a, size_t m) {
+  const auto& t = env.t_s;
+  const auto& y = env.log_amplitude;
+  FloorPower out;
+  std::vector<double>& p = out.p;
+  std::vector<bool>& valid = out.valid;
+  int& nv = out.nv;
+  // Power re the floor, less the residual signal c1 e^{-2 g (t - t_a)} and the mean c0.
+  p.assign(m, 0.0);
+  valid.assign(m, false);
+  Eigen::MatrixXd X(m, 2);
+  Eigen::VectorXd P(m);
+  for (size_t k = 0; k < m; ++k) {
+    const size_t i = a + k;
+    if (seg.dropout[i] || !std::isfinite(y[i])) continue;
+    valid[k] = true;
+    P(nv) = std::exp(2.0 * (y[i] - seg.floor_log_amplitude));
+    X(nv, 0) = 1.0, X(nv, 1) = std::exp(-2.0 * decay_rate_1_s * (t[i] - t[a]));
+    p[k] = P(nv), ++nv;
+  }
+  if (nv < kMinFloorSamples) return out;
+  const Eigen::VectorXd c = X.topRows(nv).colPivHouseholderQr().solve(P.head(nv));
+  for (size_t k = 0; k < m; ++k)
+    if (valid[k]) p[k] -= c(0) + c(1) * std::exp(-2.0 * decay_rate_1_s * (t[a + k] - t[a]));
+  return out;
+}
+
+/// Step 4: the power's autocorrelation r[0..K] (r[0] = 1) over the valid pairs, normalized by its
+/// mean square, up to k_max lags or the first under kCorrelationEnd.
+std::vector<double> powerAutocorrelation(const FloorPower& fp, int k_max) {
+  const std::vector<double>& p = fp.p;
+  const std::vector<bool>& valid = fp.valid;
+  const size_t m = p.size();
+  std::vector<double> r(1, 1.0);
+  double var = 0.0;
+  int nvar = 0;
+  for (size_t k = 0; k < m; ++k)
+    if (valid[k]) var += p[k] * p[k], ++nvar;
+  var /= std::max(1, nvar);
+  for (int lag = 1; lag <= k_max; ++lag) {
+    double s = 0.0;
+    int cnt = 0;
+    for (size_t k = 0; k + lag < m; ++k)
+      if (valid[k] && valid[k + lag]) s += p[k] * p[k + lag], ++cnt;
+    r.push_back(cnt > 0 ? s / cnt / std::max(var, 1e-300) : 0.0);
+    if (r.back() < kCorrelationEnd) break;
+  }
+  return r;
+}
+
+/// T [samples] of the given order that fits r best.
+double fitTimeConstant(int order, const std::vector<double>& r, size_t m) {
+  // Log grid of T in samples, then golden section between the neighbours of the best node.
+  const int ng = kGridNodes;
+  const double lo = std::log(kGridMinSamples), hi = std::log(kGridMaxSamples);
+  int kb = 0;
+  double eb = std::numeric_limits<double>::infinity();
+  for (int g = 0; g < ng; ++g) {
+    const double e = correlationMisfit(order, std::exp(lo + (hi - lo) * g / (ng - 1)), r, m);
+    if (e < eb) eb = e, kb = g;
+  }
+  double u0 = lo + (hi - lo) * std::max(0, kb - 1) / (ng - 1);
+  double u1 = lo + (hi - lo) * std::min(ng - 1, kb + 1) / (ng - 1);
+  const double gr = 0.5 * (std::sqrt(5.0) - 1.0);
+  for (int it = 0; it < kGoldenIterations; ++it) {
+    const double x1 = u1 - gr * (u1 - u0), x2 = u0 + gr * (u1 - u0);
+    if (correlationMisfit(order, std::exp(x1), r, m) < correlationMisfit(order, std::exp(x2), r, m))
+      u1 = x2;
+    else
+      u0 = x1;
+  }
+  return std::exp(0.5 * (u0 + u1));
+}
+
+/// Step 5: the order (1..kMaxOrder) and time constant [s] of the best fit into f; returns its sum
+/// of squares (infinite, f untouched, when no order gives a finite one).
+double fitFilterShape(const std::vector<double>& r, size_t m, double dt,
+                      RingdownDetectorFilter* f) {
+  double best = std::numeric_limits<double>::infinity();
+  for (int order = 1; order <= kMaxOrder; ++order) {
+    const double ts = fitTimeConstant(order, r, m);
+    const double e = correlationMisfit(order, ts, r, m);
+    if (e < best) best = e, f->order = order, f->time_constant_s = ts * dt;
+  }
+  return best;
+}
+
 }  // namespace
 
 double ringdownFilterPowerCorrelation(int order, double x) {
@@ -84,63 +229,30 @@ RingdownDetectorFilter estimateDetectorFilter(const RingdownEnvelope& env,
   if (!seg.has_floor) return none("no noise floor in the record");
   if (!(decay_rate_1_s > 0.0)) return none("no positive decay rate");
   const auto& t = env.t_s;
-  const auto& y = env.log_amplitude;
-  // Level at the span's end above the floor; the stretch starts 6 dB below the floor on the
-  // decay's straight continuation.
-  std::vector<double> last;
-  for (size_t i = seg.i_end > 9 ? seg.i_end - 9 : 0; i < seg.i_end && i < y.size(); ++i)
-    if (!seg.dropout[i] && std::isfinite(y[i])) last.push_back(y[i]);
-  const double above = last.empty() ? 10.0 / kDbPerNeper : median(last) - seg.floor_log_amplitude;
-  const double t_a = seg.t_end_s + (above + 6.0 / kDbPerNeper) / decay_rate_1_s;
-  size_t a = 0;
-  while (a < t.size() && t[a] < t_a) ++a;
+  // 1. The floor stretch, from 6 dB below the floor on the decay's straight continuation.
+  const size_t a = floorStretchStart(env, seg, decay_rate_1_s);
   const size_t m = t.size() - std::min(a, t.size());
-  if (m < 120) {
+  if (m < kMinFloorSamples) {
     std::ostringstream w;
     w << m << " samples of floor 6 dB below the decay's continuation, under 120";
     return none(w.str());
   }
+  // 2. Uniform sampling over it.
   std::vector<double> dts;
   for (size_t i = a + 1; i < t.size(); ++i) dts.push_back(t[i] - t[i - 1]);
   const double dt = median(dts);
   for (double d : dts)
-    if (std::fabs(d - dt) > 0.01 * dt) return none("sampling not uniform in the floor");
-  // Power re the floor, less the residual signal c1 e^{-2 g (t - t_a)} and the mean c0.
-  std::vector<double> p(m, 0.0);
-  std::vector<bool> valid(m, false);
-  Eigen::MatrixXd X(m, 2);
-  Eigen::VectorXd P(m);
-  int nv = 0;
-  for (size_t k = 0; k < m; ++k) {
-    const size_t i = a + k;
-    if (seg.dropout[i] || !std::isfinite(y[i])) continue;
-    valid[k] = true;
-    P(nv) = std::exp(2.0 * (y[i] - seg.floor_log_amplitude));
-    X(nv, 0) = 1.0, X(nv, 1) = std::exp(-2.0 * decay_rate_1_s * (t[i] - t[a]));
-    p[k] = P(nv), ++nv;
-  }
-  if (nv < 120) return none("under 120 valid floor samples");
-  const Eigen::VectorXd c = X.topRows(nv).colPivHouseholderQr().solve(P.head(nv));
-  for (size_t k = 0; k < m; ++k)
-    if (valid[k]) p[k] -= c(0) + c(1) * std::exp(-2.0 * decay_rate_1_s * (t[a + k] - t[a]));
-  const int k_max = static_cast<int>(std::min<size_t>(300, m / 4));
-  std::vector<double> r(1, 1.0);
-  double var = 0.0;
-  int nvar = 0;
-  for (size_t k = 0; k < m; ++k)
-    if (valid[k]) var += p[k] * p[k], ++nvar;
-  var /= std::max(1, nvar);
-  for (int lag = 1; lag <= k_max; ++lag) {
-    double s = 0.0;
-    int cnt = 0;
-    for (size_t k = 0; k + lag < m; ++k)
-      if (valid[k] && valid[k + lag]) s += p[k] * p[k + lag], ++cnt;
-    r.push_back(cnt > 0 ? s / cnt / std::max(var, 1e-300) : 0.0);
-    if (r.back() < 0.05) break;
-  }
-  f.n_samples = nv;
+    if (std::fabs(d - dt) > kSamplingTolerance * dt)
+      return none("sampling not uniform in the floor");
+  // 3. The floor's power less the residual signal and the mean.
+  const FloorPower fp = floorPower(env, seg, decay_rate_1_s, a, m);
+  if (fp.nv < kMinFloorSamples) return none("under 120 valid floor samples");
+  // 4. Its autocorrelation, up to where it falls under kCorrelationEnd.
+  const int k_max = static_cast<int>(std::min<size_t>(kMaxLags, m / kLagsDivisor));
+  const std::vector<double> r = powerAutocorrelation(fp, k_max);
+  f.n_samples = fp.nv;
   f.n_lags = static_cast<int>(r.size()) - 1;
-  if (r.size() < 2 || r[1] < 0.2) {
+  if (r.size() < 2 || r[1] < kMinLag1Correlation) {
     std::ostringstream w;
     w.precision(3);
     w << "floor power correlation at lag 1 is " << (r.size() > 1 ? r[1] : 0.0)
@@ -148,46 +260,22 @@ RingdownDetectorFilter estimateDetectorFilter(const RingdownEnvelope& env,
     return none(w.str());
   }
   if (static_cast<int>(r.size()) - 1 >= k_max) return none("floor correlation does not decay");
-  double best = std::numeric_limits<double>::infinity();
-  for (int order = 1; order <= kMaxOrder; ++order) {
-    // Log grid of T in samples, then golden section between the neighbours of the best node.
-    const int ng = 160;
-    const double lo = std::log(0.05), hi = std::log(400.0);
-    int kb = 0;
-    double eb = std::numeric_limits<double>::infinity();
-    for (int g = 0; g < ng; ++g) {
-      const double e = correlationMisfit(order, std::exp(lo + (hi - lo) * g / (ng - 1)), r, m);
-      if (e < eb) eb = e, kb = g;
-    }
-    double u0 = lo + (hi - lo) * std::max(0, kb - 1) / (ng - 1);
-    double u1 = lo + (hi - lo) * std::min(ng - 1, kb + 1) / (ng - 1);
-    const double gr = 0.5 * (std::sqrt(5.0) - 1.0);
-    for (int it = 0; it < 40; ++it) {
-      const double x1 = u1 - gr * (u1 - u0), x2 = u0 + gr * (u1 - u0);
-      if (correlationMisfit(order, std::exp(x1), r, m) <
-          correlationMisfit(order, std::exp(x2), r, m))
-        u1 = x2;
-      else
-        u0 = x1;
-    }
-    const double ts = std::exp(0.5 * (u0 + u1));
-    const double e = correlationMisfit(order, ts, r, m);
-    if (e < best) best = e, f.order = order, f.time_constant_s = ts * dt;
-  }
+  // 5. The order and time constant whose rho_n^2 fits it best.
+  const double best = fitFilterShape(r, m, dt, &f);
   f.found = true;
   f.source = "noise_floor";
   f.fit_rms = std::sqrt(best / f.n_lags);
   // A floor stretch under 8 filter lengths (n T) gives an autocorrelation too noisy to trust.
-  if (m * dt < 8.0 * f.order * f.time_constant_s) {
+  if (m * dt < kMinFilterLengths * f.order * f.time_constant_s) {
     f.found = false;
     return none("floor shorter than 8 filter lengths");
   }
   std::ostringstream w;
   w.precision(3);
   w << "detector low-pass of " << f.order << " pole" << (f.order > 1 ? "s" : "")
-    << ", T = " << f.time_constant_s << " s each, from the correlation of the floor's power (" << nv
-    << " samples after " << t[a] << " s, lags 1.." << f.n_lags << ", rms misfit " << f.fit_rms
-    << "); assumed to act on the amplitude (a lock-in's output filter)";
+    << ", T = " << f.time_constant_s << " s each, from the correlation of the floor's power ("
+    << fp.nv << " samples after " << t[a] << " s, lags 1.." << f.n_lags << ", rms misfit "
+    << f.fit_rms << "); assumed to act on the amplitude (a lock-in's output filter)";
   f.why = w.str();
   return f;
 }

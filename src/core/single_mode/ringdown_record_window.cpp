@@ -11,6 +11,31 @@
 namespace cvg_bench {
 namespace {
 
+/// A record under this many samples is kept whole (no window is read).
+constexpr size_t kMinRecordSamples = 16;
+/// The running median's half-width: a kSmoothDivisor-th of the record, at least kMinSmoothHalf.
+constexpr size_t kSmoothDivisor = 200;
+constexpr int kMinSmoothHalf = 2;
+/// Step 3: the head compared with the drive level is a kHeadDivisor-th of the record (2 %), at
+/// least kMinHeadSamples samples.
+constexpr size_t kHeadDivisor = 50;
+constexpr long kMinHeadSamples = 5;
+/// Step 6: the roughness is the median |second difference| over 2 kRoughnessHalf + 1 samples.
+constexpr long kRoughnessHalf = 5;
+/// Step 6: a noiseless tail covers a kTailDivisor-th of the window (at least kMinTailSamples
+/// samples) and is compared with as many samples before it.
+constexpr size_t kTailDivisor = 10;
+constexpr size_t kMinTailSamples = 10;
+/// Step 6: a noiseless tail lies this far below the peak [dB].
+constexpr double kTailBelowPeakDb = 10.0;
+/// Step 6: the stretch before a noiseless tail is this many times rougher.
+constexpr double kTailRoughnessRatio = 30.0;
+/// Step 5: a cut plateau keeps at least this many samples.
+constexpr size_t kMinPlateauSamples = 8;
+/// A window under a kMinWindowDivisor-th of the record or kMinWindowSamples samples is no window.
+constexpr size_t kMinWindowDivisor = 20;
+constexpr size_t kMinWindowSamples = 16;
+
 /// Median of the finite values of y[a, b) (clipped to the record); NaN when none.
 double medianOf(const std::vector<double>& y, long a, long b) {
   std::vector<double> w;
@@ -117,44 +142,71 @@ double fallDb(const std::vector<double>& sm, size_t a, size_t b) {
   return fall;
 }
 
-}  // namespace
+/// The record's level in dB, smoothed, and the drive level (the smoothed level's peak).
+struct Levels {
+  std::vector<double> y_db;                               ///< ln A in dB (NaN where not finite)
+  std::vector<double> sm;                                 ///< running median of y_db
+  size_t i_peak = 0;                                      ///< where sm peaks
+  double top = -std::numeric_limits<double>::infinity();  ///< the peak of sm [dB]
+};
 
-RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vector<double>& y,
-                                  const RingdownWindowOptions& o) {
+/// The levels of the record y (ln A).
+Levels readLevels(const std::vector<double>& y) {
   const size_t n = y.size();
-  RingdownWindow w;
-  w.last = n;
-  if (n < 16 || t.size() != n) return w;
   std::vector<double> y_db(n);
   std::vector<bool> skip(n);
   for (size_t i = 0; i < n; ++i) {
     y_db[i] = std::isfinite(y[i]) ? y[i] * kDbPerNeper : std::numeric_limits<double>::quiet_NaN();
     skip[i] = !std::isfinite(y[i]);
   }
-  const std::vector<double> sm = runningMedian(y_db, skip, std::max<int>(2, n / 200));
+  Levels lv;
+  lv.sm = runningMedian(y_db, skip, std::max<int>(kMinSmoothHalf, n / kSmoothDivisor));
+  lv.y_db = std::move(y_db);
+  const std::vector<double>& sm = lv.sm;
   size_t i_peak = 0;
   double top = -std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < n; ++i)
     if (std::isfinite(sm[i]) && sm[i] > top) top = sm[i], i_peak = i;
-  if (!std::isfinite(top)) return w;
-  std::ostringstream why;
-  why.precision(4);
-  // 3. A record that starts under the drive level.
-  const double head = medianOf(sm, 0, std::max<long>(5, n / 50));
+  lv.i_peak = i_peak;
+  lv.top = top;
+  return lv;
+}
+
+/// Step 3: a record that starts under the drive level is read from its last rise to near it;
+/// returns whether it started under.
+bool readStartUnderDrive(const std::vector<double>& t, const Levels& lv,
+                         const RingdownWindowOptions& o, RingdownWindow* w,
+                         std::ostringstream* why) {
+  const size_t n = lv.sm.size();
+  const std::vector<double>& sm = lv.sm;
+  const double top = lv.top;
+  const double head = medianOf(sm, 0, std::max<long>(kMinHeadSamples, n / kHeadDivisor));
   const bool started_under = top - head > o.start_below_db;
   if (started_under) {
-    size_t j = i_peak;
+    size_t j = lv.i_peak;
     while (j > 0 && !(std::isfinite(sm[j - 1]) && sm[j - 1] < top - 0.5 * o.near_top_db)) --j;
-    w.first = j;
-    why << "the record starts " << top - head << " dB under the drive level (floor before the "
-        << "drive or its ramp-up): read from " << t[j] << " s";
+    w->first = j;
+    *why << "the record starts " << top - head << " dB under the drive level (floor before the "
+         << "drive or its ramp-up): read from " << t[j] << " s";
   }
-  // 2 and 4. Steps after the peak. Each time the drive comes on again the ring-down so far is
-  // kept as a candidate (2b below).
-  struct Candidate {
-    size_t first, last;
-    std::string why;
-  };
+  return started_under;
+}
+
+/// A ring-down kept when the drive came on again after it (2b).
+struct Candidate {
+  size_t first, last;
+  std::string why;
+};
+
+/// Steps 2 and 4: the steps after the peak move the window's start (switch-off, drive on again)
+/// or end it (any other large or sharp step); returns the ring-downs the drive's coming on again
+/// ended.
+std::vector<Candidate> readSteps(const std::vector<double>& t, const Levels& lv,
+                                 const RingdownWindowOptions& o, RingdownWindow* w,
+                                 std::ostringstream* why) {
+  const std::vector<double>& sm = lv.sm;
+  const size_t i_peak = lv.i_peak;
+  const double top = lv.top;
   std::vector<Candidate> earlier;
   // The drive level is first reached here; a re-excitation may lie between it and the peak.
   size_t i_first_top = i_peak;
@@ -163,98 +215,137 @@ RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vecto
       i_first_top = i;
       break;
     }
-  for (const Step& s : findSteps(y_db, o)) {
-    if (s.i <= w.first) continue;
+  for (const Step& s : findSteps(lv.y_db, o)) {
+    if (s.i <= w->first) continue;
     const double jump = s.right - s.left;
     const bool comes_on_again =
         s.i > i_first_top && s.right >= top - o.near_top_db && s.left < top - o.near_top_db;
     if (s.i <= i_peak && !comes_on_again) continue;
     if (s.left >= top - o.near_top_db && jump < 0.0) {
-      w.first = s.i;
-      why << (why.tellp() > 0 ? "; " : "") << "a step of " << jump << " dB at switch-off ("
-          << t[s.i] << " s): the decay is read after it";
+      w->first = s.i;
+      *why << (why->tellp() > 0 ? "; " : "") << "a step of " << jump << " dB at switch-off ("
+           << t[s.i] << " s): the decay is read after it";
     } else if (comes_on_again) {
       const size_t end = s.i0 > static_cast<size_t>(o.step_half) ? s.i0 - o.step_half : s.i0;
-      if (end > w.first) earlier.push_back({w.first, end, why.str()});
-      w.first = s.i;
-      why << (why.tellp() > 0 ? "; " : "") << "the drive comes on again at " << t[s.i]
-          << " s: the last ring-down is read";
+      if (end > w->first) earlier.push_back({w->first, end, why->str()});
+      w->first = s.i;
+      *why << (why->tellp() > 0 ? "; " : "") << "the drive comes on again at " << t[s.i]
+           << " s: the last ring-down is read";
     } else if (std::fabs(jump) >= o.end_step_db || s.sharp >= o.end_step_sharpness) {
-      w.last = s.i0 > static_cast<size_t>(o.step_half) ? s.i0 - o.step_half : s.i0;
-      why << (why.tellp() > 0 ? "; " : "") << "a step of " << (jump > 0 ? "+" : "") << jump
-          << " dB in " << std::max<size_t>(o.step_half, s.i - s.i0) << " samples at " << t[s.i0]
-          << " s after the decay began (the mode leaves the detector's band, or the detector "
-             "changes range or stops): the record is read up to "
-          << t[w.last - 1] << " s";
+      w->last = s.i0 > static_cast<size_t>(o.step_half) ? s.i0 - o.step_half : s.i0;
+      *why << (why->tellp() > 0 ? "; " : "") << "a step of " << (jump > 0 ? "+" : "") << jump
+           << " dB in " << std::max<size_t>(o.step_half, s.i - s.i0) << " samples at " << t[s.i0]
+           << " s after the decay began (the mode leaves the detector's band, or the detector "
+              "changes range or stops): the record is read up to "
+           << t[w->last - 1] << " s";
       break;
     }
   }
-  // 2b. The last ring-down is read unless one before a re-excitation falls more than
-  // earlier_burst_margin_db further (a short pulse of the drive, or a burst that ends in a step out
-  // of the band, leaves only a stub of decay after it; the decay before it is the measurement).
-  {
-    // From step_half samples in: the smoothed level at a step still holds the level before it.
-    const double last_fall = fallDb(sm, w.first + o.step_half, w.last);
-    const Candidate* best = nullptr;
-    double best_fall = last_fall + o.earlier_burst_margin_db;
-    for (const Candidate& c : earlier) {
-      const double f = fallDb(sm, c.first + o.step_half, c.last);
-      if (f > best_fall) best = &c, best_fall = f;
-    }
-    if (best) {
-      const size_t last_first = w.first;
-      w.first = best->first;
-      w.last = best->last;
-      why.str(best->why);
-      why.seekp(0, std::ios_base::end);
-      why << (why.tellp() > 0 ? "; " : "") << "the ring-down before the drive came on again "
-          << "falls " << best_fall << " dB, the last one (from " << t[last_first] << " s) "
-          << last_fall << " dB: the record is read from " << t[w.first] << " s up to "
-          << t[w.last - 1] << " s";
-    }
+  return earlier;
+}
+
+/// Step 2b: the last ring-down is read unless one before a re-excitation falls more than
+/// earlier_burst_margin_db further (a short pulse of the drive, or a burst that ends in a step out
+/// of the band, leaves only a stub of decay after it; the decay before it is the measurement).
+void preferEarlierBurst(const std::vector<double>& t, const Levels& lv,
+                        const RingdownWindowOptions& o, const std::vector<Candidate>& earlier,
+                        RingdownWindow* w, std::ostringstream* why) {
+  const std::vector<double>& sm = lv.sm;
+  // From step_half samples in: the smoothed level at a step still holds the level before it.
+  const double last_fall = fallDb(sm, w->first + o.step_half, w->last);
+  const Candidate* best = nullptr;
+  double best_fall = last_fall + o.earlier_burst_margin_db;
+  for (const Candidate& c : earlier) {
+    const double f = fallDb(sm, c.first + o.step_half, c.last);
+    if (f > best_fall) best = &c, best_fall = f;
   }
-  // 6. A noiseless tail: from some sample to the window's end the local roughness (median
-  // |second difference| over 11 samples) stays under tail_roughness_db, 10 dB or more below the
-  // peak, over a tenth of the window at least, while the tenth before it is 30 times rougher. No
-  // instrument records that after a measured decay; exports append it (a fitted or padded curve).
-  {
-    std::vector<double> e2(n, std::numeric_limits<double>::quiet_NaN()), rough(n, 0.0);
-    for (size_t i = 1; i + 1 < n; ++i) e2[i] = std::fabs(y_db[i + 1] - 2.0 * y_db[i] + y_db[i - 1]);
-    for (size_t i = 0; i < n; ++i) rough[i] = medianOf(e2, long(i) - 5, long(i) + 6);
-    size_t k = w.last;
-    while (k > std::max(w.first, i_peak) + 1 &&
-           (!std::isfinite(rough[k - 1]) || rough[k - 1] <= o.tail_roughness_db))
-      --k;
-    const size_t tenth = std::max<size_t>(10, (w.last - w.first) / 10);
-    const double inside = medianOf(rough, k, w.last);
-    const double before = medianOf(rough, long(k) - long(tenth), k);
-    if (w.last - k >= tenth && k > tenth && std::isfinite(sm[k]) && sm[k] < top - 10.0 &&
-        before >= 30.0 * inside) {
-      why << (why.tellp() > 0 ? "; " : "") << "from " << t[k] << " s the level is noiseless "
-          << "(roughness " << inside << " dB against " << before << " dB before it: a curve the "
-          << "export appended, not a measurement): the record is read up to there";
-      w.last = k;
-    }
+  if (best) {
+    const size_t last_first = w->first;
+    w->first = best->first;
+    w->last = best->last;
+    why->str(best->why);
+    why->seekp(0, std::ios_base::end);
+    *why << (why->tellp() > 0 ? "; " : "") << "the ring-down before the drive came on again "
+         << "falls " << best_fall << " dB, the last one (from " << t[last_first] << " s) "
+         << last_fall << " dB: the record is read from " << t[w->first] << " s up to "
+         << t[w->last - 1] << " s";
   }
-  // 5. A long plateau (over plateau_fraction of what follows the switch-off) is cut to that
-  // fraction before it: the segmentation reads the drive level from the window's head, and a long
-  // plateau that wanders or creeps over the drive-off threshold hides the switch-off.
-  // Only in a record that started under the drive level: on the generator's beats the envelope
-  // comes back within off_below_db of the peak after the switch-off, and the cut took the
-  // plateau and the first beats (base 99530119: 3 of 20 beats without a floor).
-  if (w.last > w.first && started_under) {
-    size_t i_off = w.first;
-    for (size_t i = w.first; i < w.last; ++i)
-      if (std::isfinite(sm[i]) && sm[i] >= top - o.off_below_db) i_off = i;
-    const size_t keep = static_cast<size_t>(o.plateau_fraction * double(w.last - i_off));
-    if (i_off > w.first + std::max<size_t>(keep, 8)) {
-      w.first = i_off - std::max<size_t>(keep, 8);
-      why << (why.tellp() > 0 ? "; " : "") << "the drive level is last held at " << t[i_off]
-          << " s: read from " << t[w.first] << " s";
-    }
+}
+
+/// Step 6: a noiseless tail: from some sample to the window's end the local roughness (median
+/// |second difference| over 11 samples) stays under tail_roughness_db, 10 dB or more below the
+/// peak, over a tenth of the window at least, while the tenth before it is 30 times rougher. No
+/// instrument records that after a measured decay; exports append it (a fitted or padded curve).
+void cutNoiselessTail(const std::vector<double>& t, const Levels& lv,
+                      const RingdownWindowOptions& o, RingdownWindow* w, std::ostringstream* why) {
+  const std::vector<double>& y_db = lv.y_db;
+  const std::vector<double>& sm = lv.sm;
+  const size_t n = sm.size();
+  std::vector<double> e2(n, std::numeric_limits<double>::quiet_NaN()), rough(n, 0.0);
+  for (size_t i = 1; i + 1 < n; ++i) e2[i] = std::fabs(y_db[i + 1] - 2.0 * y_db[i] + y_db[i - 1]);
+  for (size_t i = 0; i < n; ++i)
+    rough[i] = medianOf(e2, long(i) - kRoughnessHalf, long(i) + kRoughnessHalf + 1);
+  size_t k = w->last;
+  while (k > std::max(w->first, lv.i_peak) + 1 &&
+         (!std::isfinite(rough[k - 1]) || rough[k - 1] <= o.tail_roughness_db))
+    --k;
+  const size_t tenth = std::max<size_t>(kMinTailSamples, (w->last - w->first) / kTailDivisor);
+  const double inside = medianOf(rough, k, w->last);
+  const double before = medianOf(rough, long(k) - long(tenth), k);
+  if (w->last - k >= tenth && k > tenth && std::isfinite(sm[k]) &&
+      sm[k] < lv.top - kTailBelowPeakDb && before >= kTailRoughnessRatio * inside) {
+    *why << (why->tellp() > 0 ? "; " : "") << "from " << t[k] << " s the level is noiseless "
+         << "(roughness " << inside << " dB against " << before << " dB before it: a curve the "
+         << "export appended, not a measurement): the record is read up to there";
+    w->last = k;
   }
+}
+
+/// Step 5: a long plateau (over plateau_fraction of what follows the switch-off) is cut to that
+/// fraction before it: the segmentation reads the drive level from the window's head, and a long
+/// plateau that wanders or creeps over the drive-off threshold hides the switch-off.
+void cutLongPlateau(const std::vector<double>& t, const Levels& lv, const RingdownWindowOptions& o,
+                    RingdownWindow* w, std::ostringstream* why) {
+  const std::vector<double>& sm = lv.sm;
+  size_t i_off = w->first;
+  for (size_t i = w->first; i < w->last; ++i)
+    if (std::isfinite(sm[i]) && sm[i] >= lv.top - o.off_below_db) i_off = i;
+  const size_t keep = static_cast<size_t>(o.plateau_fraction * double(w->last - i_off));
+  if (i_off > w->first + std::max<size_t>(keep, kMinPlateauSamples)) {
+    w->first = i_off - std::max<size_t>(keep, kMinPlateauSamples);
+    *why << (why->tellp() > 0 ? "; " : "") << "the drive level is last held at " << t[i_off]
+         << " s: read from " << t[w->first] << " s";
+  }
+}
+
+}  // namespace
+
+RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vector<double>& y,
+                                  const RingdownWindowOptions& o) {
+  const size_t n = y.size();
+  RingdownWindow w;
+  w.last = n;
+  if (n < kMinRecordSamples || t.size() != n) return w;
+  const Levels lv = readLevels(y);
+  if (!std::isfinite(lv.top)) return w;
+  std::ostringstream why;
+  why.precision(4);
+  // 3. A record that starts under the drive level.
+  const bool started_under = readStartUnderDrive(t, lv, o, &w, &why);
+  // 2 and 4. Steps after the peak. Each time the drive comes on again the ring-down so far is
+  // kept as a candidate (2b below).
+  const std::vector<Candidate> earlier = readSteps(t, lv, o, &w, &why);
+  // 2b. The last ring-down unless an earlier one falls further.
+  preferEarlierBurst(t, lv, o, earlier, &w, &why);
+  // 6. A noiseless tail appended by the export.
+  cutNoiselessTail(t, lv, o, &w, &why);
+  // 5. A long plateau, only in a record that started under the drive level: on the generator's
+  // beats the envelope comes back within off_below_db of the peak after the switch-off, and the
+  // cut took the plateau and the first beats (base 99530119: 3 of 20 beats without a floor).
+  if (w.last > w.first && started_under) cutLongPlateau(t, lv, o, &w, &why);
   // A window too short to hold a ring-down (a twentieth of the record, 16 samples) is no window.
-  if (w.last < w.first + std::max<size_t>(16, n / 20)) w.first = 0, w.last = n, why.str("");
+  if (w.last < w.first + std::max<size_t>(kMinWindowSamples, n / kMinWindowDivisor))
+    w.first = 0, w.last = n, why.str("");
   w.why = why.str();
   return w;
 }

@@ -28,6 +28,81 @@ constexpr double kFloorScatter = 0.2;
 /// Without the evidence, a floor also confirms when that scatter is this many times the one over
 /// the first half of the decay before the crossing (the signal's own noise).
 constexpr double kFloorScatterRatio = 2.0;
+/// A ring-down needs this many samples: in the envelope, on the peak's grid, in the span (step 4).
+constexpr size_t kMinSamples = 8;
+/// Robust sd over the median absolute deviation (normal noise).
+constexpr double kMadToSd = 1.4826;
+/// Step 1: drop-outs are read against a running median of this half-width (window 11).
+constexpr int kDropoutMedianHalf = 5;
+/// Step 1: the noise scale is read over the record's first half, at least this many samples.
+constexpr size_t kMinScaleSamples = 8;
+/// Step 1: a drop-out lies this many robust sd below the running median (or dropout_depth_db) ...
+constexpr double kDropoutDepthSd = 8.0;
+/// ... and this many local robust sd (MAD about the running median over 2 kLocalMadHalf + 1
+/// samples).
+constexpr double kDropoutLocalSd = 6.0;
+constexpr size_t kLocalMadHalf = 10;
+/// The smoothed envelope: a running median of half-width a kSmoothDivisor-th of the window, at
+/// least kMinSmoothHalf samples.
+constexpr size_t kSmoothDivisor = 100;
+constexpr int kMinSmoothHalf = 2;
+/// The peak is read on a grid of at most this many samples.
+constexpr size_t kPeakGridPoints = 1500;
+/// Step 2: the tail level is the median over the window's last kTailDivisor-th, at least
+/// kMinTailSamples samples.
+constexpr size_t kTailDivisor = 10;
+constexpr size_t kMinTailSamples = 4;
+/// Step 2: the floor fit starts kStretchTopDb (or kStretchTopFraction of the drop) above the tail
+/// level [dB] ...
+constexpr double kStretchTopDb = 25.0;
+constexpr double kStretchTopFraction = 0.75;
+/// ... when the decay goes on to kStretchBottomDb (or kStretchBottomFraction of the drop) above it
+/// [dB] over more than kMinStretchSamples samples.
+constexpr double kStretchBottomDb = 10.0;
+constexpr double kStretchBottomFraction = 0.25;
+constexpr size_t kMinStretchSamples = 4;
+/// Step 2: the envelope reaches a confirmed floor within this of it [dB] (floor_start_s).
+constexpr double kFloorReachDb = 3.0;
+/// Step 3: the plateau level is the median over the window's first kHeadDivisor-th, at least
+/// kMinHeadSamples samples.
+constexpr size_t kHeadDivisor = 20;
+constexpr size_t kMinHeadSamples = 5;
+/// Step 3: the switch-off threshold lies max(kSwitchOffSd robust sd, kSwitchOffMinDb [dB]) below
+/// the plateau; for a plateau that creeps, kWideSwitchOffDb [dB].
+constexpr double kSwitchOffSd = 6.0;
+constexpr double kSwitchOffMinDb = 0.1;
+constexpr double kWideSwitchOffDb = 1.0;
+/// Step 3: the crossing is read below this quantile of the head (h.size() / 20: the 5th
+/// percentile).
+constexpr size_t kPercentileDivisor = 20;
+/// Step 3: the rate after the crossing over a kAfterDivisor-th of the window, at least
+/// kMinAfterSamples samples.
+constexpr size_t kAfterDivisor = 20;
+constexpr size_t kMinAfterSamples = 8;
+/// Step 3: falling steadily: differences over a kLagDivisor-th of the stretch before the crossing,
+/// kFallingShare of them negative, and a mean rate of kPlateauRateRatio of the one after or more.
+constexpr size_t kLagDivisor = 10;
+constexpr double kFallingShare = 0.9;
+constexpr double kPlateauRateRatio = 0.3;
+/// Step 3: a plateau's crossing lies past this sample, and later than kPlateauDelay times the time
+/// the decay takes to fall by the threshold.
+constexpr size_t kMinCrossIndex = 2;
+constexpr double kPlateauDelay = 3.0;
+/// Detector settling is read on spans of more than this many samples ...
+constexpr size_t kMinSettlingSpan = 40;
+/// ... within the first kSettlingSkipDb of decay [dB] (at most that is skipped), against the rate
+/// from there to kSettlingRateEndDb [dB] over more than kMinSettlingRateSamples samples ...
+constexpr double kSettlingSkipDb = 3.0;
+constexpr double kSettlingRateEndDb = 13.0;
+constexpr size_t kMinSettlingRateSamples = 8;
+/// ... with the local rate over a kRateWindowDivisor-th of the window, at least kMinRateWindow
+/// samples ...
+constexpr size_t kRateWindowDivisor = 80;
+constexpr size_t kMinRateWindow = 8;
+/// ... and the span starts this many times the time to the rate's peak after the drive-off.
+constexpr double kSettlingTimeFactor = 2.0;
+/// Step 4: a decay spans min_decay_db and this many robust sd of ln A or more.
+constexpr double kMinDecaySd = 10.0;
 
 double median(const std::vector<double>& v) {
   return sampleMedian(v);
@@ -176,257 +251,303 @@ std::vector<double> runningMedian(const std::vector<double>& y, const std::vecto
 
 namespace {
 
-/// Steps 1-4 of the header on a window that holds one ring-down.
-RingdownSegment segmentWindow(const RingdownEnvelope& env,
-                              const RingdownSegmentationOptions& options) {
-  const auto problems = options.validate();
-  if (!problems.empty()) throw InputError("ring-down segmentation: " + problems.front());
-  const size_t n = env.size();
-  if (n < 8) throw InputError("ring-down envelope has " + std::to_string(n) + " samples (< 8)");
-  const auto& t = env.t_s;
-  const auto& y = env.log_amplitude;
-  RingdownSegment seg;
-  seg.dropout.assign(n, false);
-  for (size_t i = 0; i < n; ++i) seg.dropout[i] = !std::isfinite(y[i]);
+/// The smoothed envelope's peak, read on a grid of at most kPeakGridPoints samples.
+struct EnvelopePeak {
+  double level = -std::numeric_limits<double>::infinity();  ///< ln A
+  size_t i = 0;
+};
 
-  // 1. Drop-outs against the running median (window 11), robust scale from differences.
-  {
-    const std::vector<double> med = runningMedian(y, seg.dropout, 5);
-    std::vector<double> d;
-    // Scale from the first half (plateau and early decay): the floor's log noise is far larger.
-    for (size_t i = 1; i < std::max<size_t>(n / 2, 8); ++i)
-      if (!seg.dropout[i] && !seg.dropout[i - 1]) d.push_back(std::fabs(y[i] - y[i - 1]));
-    seg.noise_sd_log = d.empty() ? 0.0 : 1.4826 * median(d) / std::sqrt(2.0);
-    // Depth: 3 dB, or 6 local robust sd (MAD about the running median over 21 samples), so that
-    // the Rice dips of additive noise near the floor are not taken for drop-outs.
-    const double depth0 = std::max(8.0 * seg.noise_sd_log, options.dropout_depth_db / kDbPerNeper);
-    std::vector<double> dev(n, 0.0);
-    for (size_t i = 0; i < n; ++i)
-      dev[i] = std::isfinite(med[i]) && !seg.dropout[i] ? std::fabs(y[i] - med[i]) : 0.0;
-    for (size_t i = 0; i < n; ++i) {
-      if (seg.dropout[i] || !std::isfinite(med[i])) continue;
-      std::vector<double> w;
-      for (size_t j = i >= 10 ? i - 10 : 0; j <= std::min(n - 1, i + 10); ++j)
-        if (!seg.dropout[j]) w.push_back(dev[j]);
-      const double local = 1.4826 * median(w);
-      if (y[i] < med[i] - std::max(depth0, 6.0 * local)) seg.dropout[i] = true;
-    }
+/// Step 1: drop-outs against the running median (window 11), robust scale from differences; sets
+/// seg's dropout and noise_sd_log.
+void markDropouts(const std::vector<double>& y, size_t n,
+                  const RingdownSegmentationOptions& options, RingdownSegment* seg) {
+  std::vector<bool>& dropout = seg->dropout;
+  const std::vector<double> med = runningMedian(y, dropout, kDropoutMedianHalf);
+  std::vector<double> d;
+  // Scale from the first half (plateau and early decay): the floor's log noise is far larger.
+  for (size_t i = 1; i < std::max<size_t>(n / 2, kMinScaleSamples); ++i)
+    if (!dropout[i] && !dropout[i - 1]) d.push_back(std::fabs(y[i] - y[i - 1]));
+  seg->noise_sd_log = d.empty() ? 0.0 : kMadToSd * median(d) / std::sqrt(2.0);
+  // Depth: 3 dB, or 6 local robust sd (MAD about the running median over 21 samples), so that
+  // the Rice dips of additive noise near the floor are not taken for drop-outs.
+  const double depth0 =
+      std::max(kDropoutDepthSd * seg->noise_sd_log, options.dropout_depth_db / kDbPerNeper);
+  std::vector<double> dev(n, 0.0);
+  for (size_t i = 0; i < n; ++i)
+    dev[i] = std::isfinite(med[i]) && !dropout[i] ? std::fabs(y[i] - med[i]) : 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    if (dropout[i] || !std::isfinite(med[i])) continue;
+    std::vector<double> w;
+    for (size_t j = i >= kLocalMadHalf ? i - kLocalMadHalf : 0;
+         j <= std::min(n - 1, i + kLocalMadHalf); ++j)
+      if (!dropout[j]) w.push_back(dev[j]);
+    const double local = kMadToSd * median(w);
+    if (y[i] < med[i] - std::max(depth0, kDropoutLocalSd * local)) dropout[i] = true;
   }
-  const int half = std::max(2, static_cast<int>(n / 100));
-  const std::vector<double> sm = runningMedian(y, seg.dropout, half);
+}
 
+/// The peak of the smoothed envelope sm; throws AnalysisError under kMinSamples usable samples.
+EnvelopePeak smoothedPeak(const std::vector<double>& sm, size_t n) {
   // A subsampled grid of the smoothed envelope (<= 1500 points) for the peak below.
-  const size_t stride = std::max<size_t>(1, n / 1500);
+  const size_t stride = std::max<size_t>(1, n / kPeakGridPoints);
   std::vector<size_t> idx;
   for (size_t i = 0; i < n; i += stride)
     if (std::isfinite(sm[i])) idx.push_back(i);
-  if (idx.size() < 8) throw AnalysisError("ring-down: fewer than 8 usable envelope samples");
-
-  // 2. Noise floor: from 25 dB above the level of the record's last tenth to the end, a straight
-  // decay plus an additive floor beats the straight decay, with the floor above its continuation.
-  const size_t tail_a = n - std::max<size_t>(4, n / 10);
+  if (idx.size() < kMinSamples)
+    throw AnalysisError("ring-down: fewer than 8 usable envelope samples");
   double peak_sm = -std::numeric_limits<double>::infinity();
   size_t i_peak = 0;
   for (size_t i : idx)
     if (sm[i] > peak_sm) peak_sm = sm[i], i_peak = i;
+  EnvelopePeak peak;
+  peak.level = peak_sm;
+  peak.i = i_peak;
+  return peak;
+}
+
+/// The level of the record's last tenth and the decay's last stretch [a, b) above it (a, b = n
+/// when the smoothed envelope does not fall that far after the peak).
+struct LastStretch {
+  double tail_level = 0.0;  ///< median smoothed level of the last tenth (ln A)
+  double total = 0.0;       ///< the peak above it
+  size_t a = 0, b = 0;
+};
+
+LastStretch lastStretch(const std::vector<double>& sm, size_t n, const EnvelopePeak& peak) {
+  const size_t tail_a = n - std::max<size_t>(kMinTailSamples, n / kTailDivisor);
+  std::vector<double> tail;
+  for (size_t i = tail_a; i < n; ++i)
+    if (std::isfinite(sm[i])) tail.push_back(sm[i]);
+  const double tail_level = tail.empty() ? peak.level : median(tail);
+  const double total = peak.level - tail_level;
+  // The decay's last stretch: from 25 dB (or 3/4 of the drop) to 10 dB (or 1/4) above the tail.
+  const double hi = tail_level + std::min(kStretchTopDb / kDbPerNeper, kStretchTopFraction * total);
+  const double lo =
+      tail_level + std::min(kStretchBottomDb / kDbPerNeper, kStretchBottomFraction * total);
+  size_t a = n, b = n;
+  for (size_t i = peak.i; i < n; ++i) {
+    if (!std::isfinite(sm[i])) continue;
+    if (a == n && sm[i] <= hi) a = i;
+    if (sm[i] <= lo) {
+      b = i;
+      break;
+    }
+  }
+  LastStretch out;
+  out.tail_level = tail_level;
+  out.total = total;
+  out.a = a;
+  out.b = b;
+  return out;
+}
+
+/// What step 2 hands on: the span's end (n when no floor ends it) and the margin above a floor.
+struct FloorCut {
+  size_t i_end = 0;
+  double margin_db = 0.0;
+};
+
+/// Step 2: a confirmed floor (seg's has_floor, floor_log_amplitude, floor_start_s) or a suspected
+/// one (suspected_floor_log_amplitude) ends the span margin_db above it.
+FloorCut readFloor(const RingdownEnvelope& env, const std::vector<double>& sm, size_t n,
+                   const EnvelopePeak& peak, const RingdownSegmentationOptions& options,
+                   RingdownSegment* seg) {
+  const auto& t = env.t_s;
+  const auto& y = env.log_amplitude;
+  const double peak_sm = peak.level;
+  const size_t i_peak = peak.i;
   size_t i_end = n;
   double margin_db = options.floor_margin_db;
-  {
-    std::vector<double> tail;
-    for (size_t i = tail_a; i < n; ++i)
-      if (std::isfinite(sm[i])) tail.push_back(sm[i]);
-    const double tail_level = tail.empty() ? peak_sm : median(tail);
-    const double total = peak_sm - tail_level;
-    // The decay's last stretch: from 25 dB (or 3/4 of the drop) to 10 dB (or 1/4) above the tail.
-    const double hi = tail_level + std::min(25.0 / kDbPerNeper, 0.75 * total);
-    const double lo = tail_level + std::min(10.0 / kDbPerNeper, 0.25 * total);
-    size_t a = n, b = n;
-    for (size_t i = i_peak; i < n; ++i) {
-      if (!std::isfinite(sm[i])) continue;
-      if (a == n && sm[i] <= hi) a = i;
-      if (sm[i] <= lo) {
-        b = i;
-        break;
-      }
+  const LastStretch ls = lastStretch(sm, n, peak);
+  const size_t a = ls.a, b = ls.b;
+  if (ls.total > (options.floor_margin_db + options.min_decay_db) / kDbPerNeper && a < n && b < n &&
+      b > a + kMinStretchSamples) {
+    const FloorFit ff = fitFloor(t, y, seg->dropout, a, ls.tail_level);
+    const double excess = ff.floor_log - ff.line_end;
+    const bool scatters = ff.tail_sd > kFloorScatter;  // false when NaN
+    const bool confirmed =
+        ff.ok && ff.slope < 0.0 && excess > kFloorExcessDb / kDbPerNeper && scatters &&
+        (ff.evidence > kFloorEvidence || ff.tail_sd > kFloorScatterRatio * ff.head_sd);
+    // A decay that rises less than margin + short_decay_db above its floor keeps
+    // short_decay_db of decay: the margin shrinks to what is left, down to min_floor_margin_db
+    // (the fit holds the floor; D008 of the development set: 16 dB above a floor, 3 dB left).
+    if (ff.ok) {
+      const double above_db = (peak_sm - ff.floor_log) * kDbPerNeper;
+      margin_db = std::max(std::min(options.floor_margin_db, above_db - options.short_decay_db),
+                           std::min(options.floor_margin_db, options.min_floor_margin_db));
     }
-    if (total > (options.floor_margin_db + options.min_decay_db) / kDbPerNeper && a < n && b < n &&
-        b > a + 4) {
-      const FloorFit ff = fitFloor(t, y, seg.dropout, a, tail_level);
-      const double excess = ff.floor_log - ff.line_end;
-      const bool scatters = ff.tail_sd > kFloorScatter;  // false when NaN
-      const bool confirmed =
-          ff.ok && ff.slope < 0.0 && excess > kFloorExcessDb / kDbPerNeper && scatters &&
-          (ff.evidence > kFloorEvidence || ff.tail_sd > kFloorScatterRatio * ff.head_sd);
-      // A decay that rises less than margin + short_decay_db above its floor keeps
-      // short_decay_db of decay: the margin shrinks to what is left, down to min_floor_margin_db
-      // (the fit holds the floor; D008 of the development set: 16 dB above a floor, 3 dB left).
-      if (ff.ok) {
-        const double above_db = (peak_sm - ff.floor_log) * kDbPerNeper;
-        margin_db = std::max(std::min(options.floor_margin_db, above_db - options.short_decay_db),
-                             std::min(options.floor_margin_db, options.min_floor_margin_db));
-      }
-      if (ff.ok && ff.slope < 0.0 && !confirmed && excess > 0.0 && scatters) {
-        // Not confirmed as a floor, but the best line-plus-floor puts one above the line's end:
-        // a record that ends in the bend towards its floor. The span stops the margin above that
-        // level all the same (no floor is claimed; the fit below it would bend without a model).
-        seg.suspected_floor_log_amplitude = ff.floor_log;
-        const double cut = ff.floor_log + margin_db / kDbPerNeper;
-        for (size_t i = i_peak; i < n; ++i)
-          if (std::isfinite(sm[i]) && sm[i] <= cut) {
-            i_end = i;
-            break;
-          }
-      }
-      if (confirmed) {
-        const double floor_log = ff.floor_log;
-        seg.has_floor = true;
-        seg.floor_log_amplitude = floor_log;
-        const double cut = floor_log + margin_db / kDbPerNeper;
-        // The span ends at the first smoothed sample after the peak at or below the cut.
-        for (size_t i = i_peak; i < n; ++i)
-          if (std::isfinite(sm[i]) && sm[i] <= cut) {
-            i_end = i;
-            break;
-          }
-        const double reach = floor_log + 3.0 / kDbPerNeper;
-        seg.floor_start_s = t.back();
-        for (size_t i = i_end; i < n; ++i)
-          if (std::isfinite(sm[i]) && sm[i] <= reach) {
-            seg.floor_start_s = t[i];
-            break;
-          }
-      }
+    if (ff.ok && ff.slope < 0.0 && !confirmed && excess > 0.0 && scatters) {
+      // Not confirmed as a floor, but the best line-plus-floor puts one above the line's end:
+      // a record that ends in the bend towards its floor. The span stops the margin above that
+      // level all the same (no floor is claimed; the fit below it would bend without a model).
+      seg->suspected_floor_log_amplitude = ff.floor_log;
+      const double cut = ff.floor_log + margin_db / kDbPerNeper;
+      for (size_t i = i_peak; i < n; ++i)
+        if (std::isfinite(sm[i]) && sm[i] <= cut) {
+          i_end = i;
+          break;
+        }
+    }
+    if (confirmed) {
+      const double floor_log = ff.floor_log;
+      seg->has_floor = true;
+      seg->floor_log_amplitude = floor_log;
+      const double cut = floor_log + margin_db / kDbPerNeper;
+      // The span ends at the first smoothed sample after the peak at or below the cut.
+      for (size_t i = i_peak; i < n; ++i)
+        if (std::isfinite(sm[i]) && sm[i] <= cut) {
+          i_end = i;
+          break;
+        }
+      const double reach = floor_log + kFloorReachDb / kDbPerNeper;
+      seg->floor_start_s = t.back();
+      for (size_t i = i_end; i < n; ++i)
+        if (std::isfinite(sm[i]) && sm[i] <= reach) {
+          seg->floor_start_s = t[i];
+          break;
+        }
     }
   }
+  FloorCut out;
+  out.i_end = i_end;
+  out.margin_db = margin_db;
+  return out;
+}
 
-  // 3. Drive switch-off: the plateau level c0 is the median of the smoothed envelope over the first
-  // twentieth (a running median keeps the corner sharp); the decay starts where the envelope first
-  // falls delta = max(6 sd, 0.1 dB) below it. A plateau exists when that crossing comes later than
-  // three times the time the decay takes to fall by delta.
-  const size_t n_head = std::min(n, std::max<size_t>(5, n / 20));
-  std::vector<double> head;
-  for (size_t i = 0; i < n_head; ++i)
-    if (std::isfinite(sm[i])) head.push_back(sm[i]);
-  const double c0 = median(head);
-  const double delta_noise = std::max(6.0 * seg.noise_sd_log, 0.1 / kDbPerNeper);
-  // The switch-off read with a threshold delta below the plateau: the crossing, the decay rate
-  // after it, whether the stretch before it falls steadily and whether it is a plateau.
-  struct SwitchOff {
-    double delta = 0.0;
-    size_t i_cross = 0;
-    double s_after = 0.0;
-    bool falling = false, has_plateau = false;
-  };
-  auto readSwitchOff = [&](double delta) {
-    // The crossing is taken below the head's 5th percentile: a plateau that beats (two close modes
-    // driven together) dips below its median every beat period.
-    auto crossing = [&](size_t upto, double* level) {
-      std::vector<double> h;
-      for (size_t i = 0; i < upto; ++i)
-        if (std::isfinite(sm[i])) h.push_back(sm[i]);
-      std::sort(h.begin(), h.end());
-      *level = h.empty() ? c0 : h[h.size() / 20];
-      for (size_t i = 0; i < i_end; ++i)
-        if (std::isfinite(sm[i]) && sm[i] < *level - delta) return i;
-      return size_t{0};
-    };
-    double c_low = c0;
-    size_t i_cross = crossing(n_head, &c_low);
-    // A plateau shorter than the head is followed by decay samples that lower that percentile (the
-    // drive-off then lands up to 3 dB into the decay and the span past a fast first stage). The
-    // head up to its last sample at or above the median gives an earlier crossing; it is taken when
-    // the envelope does not come back above that level before the first crossing (a beating plateau
-    // does).
-    {
-      size_t last_up = 0;
-      for (size_t i = 0; i < n_head; ++i)
-        if (std::isfinite(sm[i]) && sm[i] >= c0) last_up = i;
-      double c_short = c0;
-      const size_t i_short = crossing(last_up + 1, &c_short);
-      bool back = false;
-      for (size_t i = i_short; i < i_cross && !back; ++i)
-        back = std::isfinite(sm[i]) && sm[i] >= c_short;
-      if (i_short < i_cross && !back) i_cross = i_short, c_low = c_short;
-    }
-    const size_t m_after = std::min(i_end, i_cross + std::max<size_t>(8, n / 20));
-    const double s_after = -slopeOver(t, sm, seg.dropout, i_cross, m_after);
-    // A plateau does not fall steadily at 0.3 or more of the rate after the crossing (a record that
-    // starts inside a fast first stage of the decay has no plateau; its median level over the first
-    // twentieth is no drive level). Falling means steadily: 90 % of the differences over a tenth of
-    // the stretch negative (a beating plateau falls and rises).
-    const double s_before = -slopeOver(t, sm, seg.dropout, 0, i_cross);
-    bool falling = false;
-    {
-      const size_t lag = std::max<size_t>(1, i_cross / 10);
-      size_t down = 0, all = 0;
-      for (size_t i = 0; i + lag < i_cross; ++i)
-        if (std::isfinite(sm[i]) && std::isfinite(sm[i + lag])) ++all, down += sm[i + lag] < sm[i];
-      falling = all > 0 && down >= 0.9 * all && s_before >= 0.3 * s_after;
-    }
-    SwitchOff r;
-    r.delta = delta, r.i_cross = i_cross, r.s_after = s_after, r.falling = falling;
-    r.has_plateau =
-        s_after > 0.0 && i_cross > 2 && t[i_cross] - t.front() > 3.0 * delta / s_after && !falling;
-    return r;
-  };
-  // A drive level that creeps by a few tenths of a dB (an oscillator's amplitude loop on a real
-  // export, D060 of the development set: 0.6 dB over 1.6 s) crosses a noise-sized threshold on the
-  // plateau, where nothing decays after it: then the switch-off is read 1 dB below the plateau.
-  SwitchOff so = readSwitchOff(delta_noise);
-  if (!so.has_plateau && !so.falling) {
-    const SwitchOff wide = readSwitchOff(std::max(delta_noise, 1.0 / kDbPerNeper));
-    if (wide.has_plateau) so = wide;
-  }
-  const double delta = so.delta;
-  const size_t i_cross = so.i_cross;
-  const double s_after = so.s_after;
-  seg.has_plateau = so.has_plateau;
-  seg.drive_off_s = seg.has_plateau ? t[i_cross] - delta / s_after : t.front();
-  seg.plateau_log_amplitude = c0;
-  const double best_c = c0;
-  size_t i_start = seg.has_plateau ? i_cross : 0;
-  // Detector settling: a lock-in or video filter rounds the corner at switch-off, so the decay rate
-  // starts near zero and rises over a few filter time constants while the true rate may already be
-  // falling (damping that grows with the amplitude, a fast first stage). The local rate (over
-  // n / 80 samples) peaks once the filter has nearly caught up; the span starts at the drive-off
-  // plus twice the time to that peak, where the filter's transient has decayed (a 2-pole filter
-  // leaves ~1 dB at the corner, 0.25 dB after 2.5 time constants, 0.03 dB after 5). At most the
-  // first 3 dB of decay are skipped.
-  if (i_end > i_start + 40) {
-    const double s0 = sm[i_start];
-    size_t a3 = i_end, a13 = i_end;
-    for (size_t i = i_start; i < i_end; ++i) {
-      if (!std::isfinite(sm[i])) continue;
-      if (a3 == i_end && sm[i] <= s0 - 3.0 / kDbPerNeper) a3 = i;
-      if (sm[i] <= s0 - 13.0 / kDbPerNeper) {
-        a13 = i;
-        break;
-      }
-    }
-    if (a3 < i_end && a13 > a3 + 8) {
-      // Time of the peak local rate within the first 3 dB (window centre).
-      const size_t w = std::max<size_t>(8, n / 80);
-      double peak = slopeOver(t, sm, seg.dropout, a3, a13);  // negative: ln A falls
-      double t_peak = seg.drive_off_s;
-      for (size_t i = i_start; i + w < a3; ++i) {
-        const double sl = slopeOver(t, sm, seg.dropout, i, i + w);
-        if (sl < peak) peak = sl, t_peak = 0.5 * (t[i] + t[i + w - 1]);
-      }
-      const double t_skip = seg.drive_off_s + 2.0 * std::max(0.0, t_peak - seg.drive_off_s);
-      size_t i_new = i_start;
-      while (i_new < a3 && t[i_new] < t_skip) ++i_new;
-      i_start = i_new;
-    }
-  }
-  seg.floor_margin_db = margin_db;
-  if (i_end <= i_start + 8) throw AnalysisError("ring-down: no decay above the noise floor");
-  seg.i_start = i_start;
-  seg.i_end = i_end;
+/// What the switch-off reading of step 3 looks at: the smoothed envelope up to the span's end
+/// i_end, the head of n_head samples and its median level c0.
+struct SwitchOffInput {
+  const std::vector<double>& t;
+  const std::vector<double>& sm;
+  const std::vector<bool>& dropout;
+  size_t n, n_head, i_end;
+  double c0;
+};
+
+/// The switch-off read with a threshold delta below the plateau: the crossing, the decay rate
+/// after it, whether the stretch before it falls steadily and whether it is a plateau.
+struct SwitchOff {
+  double delta = 0.0;
+  size_t i_cross = 0;
+  double s_after = 0.0;
+  bool falling = false, has_plateau = false;
+};
+
+/// The first smoothed sample before i_end more than delta below the 5th percentile of the
+/// smoothed samples [0, upto) (c0 when none), which goes to *level; 0 when none.
+size_t crossingBelow(const SwitchOffInput& in, double delta, size_t upto, double* level) {
+  const std::vector<double>& sm = in.sm;
+  std::vector<double> h;
+  for (size_t i = 0; i < upto; ++i)
+    if (std::isfinite(sm[i])) h.push_back(sm[i]);
+  std::sort(h.begin(), h.end());
+  *level = h.empty() ? in.c0 : h[h.size() / kPercentileDivisor];
+  for (size_t i = 0; i < in.i_end; ++i)
+    if (std::isfinite(sm[i]) && sm[i] < *level - delta) return i;
+  return size_t{0};
+}
+
+/// The switch-off's crossing with threshold delta.
+size_t switchOffCrossing(const SwitchOffInput& in, double delta) {
+  const std::vector<double>& sm = in.sm;
+  // The crossing is taken below the head's 5th percentile: a plateau that beats (two close modes
+  // driven together) dips below its median every beat period.
+  double c_low = in.c0;
+  size_t i_cross = crossingBelow(in, delta, in.n_head, &c_low);
+  // A plateau shorter than the head is followed by decay samples that lower that percentile (the
+  // drive-off then lands up to 3 dB into the decay and the span past a fast first stage). The
+  // head up to its last sample at or above the median gives an earlier crossing; it is taken when
+  // the envelope does not come back above that level before the first crossing (a beating plateau
+  // does).
+  size_t last_up = 0;
+  for (size_t i = 0; i < in.n_head; ++i)
+    if (std::isfinite(sm[i]) && sm[i] >= in.c0) last_up = i;
+  double c_short = in.c0;
+  const size_t i_short = crossingBelow(in, delta, last_up + 1, &c_short);
+  bool back = false;
+  for (size_t i = i_short; i < i_cross && !back; ++i)
+    back = std::isfinite(sm[i]) && sm[i] >= c_short;
+  if (i_short < i_cross && !back) i_cross = i_short, c_low = c_short;
+  return i_cross;
+}
+
+/// Whether the envelope before the crossing falls steadily: 90 % of its differences over a tenth
+/// of the stretch negative and its mean rate 0.3 or more of s_after (a beating plateau falls and
+/// rises).
+bool fallsSteadily(const SwitchOffInput& in, size_t i_cross, double s_after) {
+  const std::vector<double>& sm = in.sm;
+  const double s_before = -slopeOver(in.t, sm, in.dropout, 0, i_cross);
+  const size_t lag = std::max<size_t>(1, i_cross / kLagDivisor);
+  size_t down = 0, all = 0;
+  for (size_t i = 0; i + lag < i_cross; ++i)
+    if (std::isfinite(sm[i]) && std::isfinite(sm[i + lag])) ++all, down += sm[i + lag] < sm[i];
+  return all > 0 && down >= kFallingShare * all && s_before >= kPlateauRateRatio * s_after;
+}
+
+SwitchOff readSwitchOff(const SwitchOffInput& in, double delta) {
+  const std::vector<double>& t = in.t;
+  const size_t i_cross = switchOffCrossing(in, delta);
+  const size_t m_after =
+      std::min(in.i_end, i_cross + std::max<size_t>(kMinAfterSamples, in.n / kAfterDivisor));
+  const double s_after = -slopeOver(t, in.sm, in.dropout, i_cross, m_after);
+  // A plateau does not fall steadily at 0.3 or more of the rate after the crossing (a record that
+  // starts inside a fast first stage of the decay has no plateau; its median level over the first
+  // twentieth is no drive level).
+  const bool falling = fallsSteadily(in, i_cross, s_after);
+  SwitchOff r;
+  r.delta = delta, r.i_cross = i_cross, r.s_after = s_after, r.falling = falling;
+  r.has_plateau = s_after > 0.0 && i_cross > kMinCrossIndex &&
+                  t[i_cross] - t.front() > kPlateauDelay * delta / s_after && !falling;
+  return r;
+}
+
+/// Detector settling: a lock-in or video filter rounds the corner at switch-off, so the decay rate
+/// starts near zero and rises over a few filter time constants while the true rate may already be
+/// falling (damping that grows with the amplitude, a fast first stage). The local rate (over
+/// n / 80 samples) peaks once the filter has nearly caught up; the span starts at the drive-off
+/// plus twice the time to that peak, where the filter's transient has decayed (a 2-pole filter
+/// leaves ~1 dB at the corner, 0.25 dB after 2.5 time constants, 0.03 dB after 5). At most the
+/// first 3 dB of decay are skipped. Returns the span's start.
+size_t settledStart(const std::vector<double>& t, const std::vector<double>& sm,
+                    const std::vector<bool>& dropout, size_t n, size_t i_start, size_t i_end,
+                    double drive_off_s) {
+  if (!(i_end > i_start + kMinSettlingSpan)) return i_start;
+  const double s0 = sm[i_start];
+  size_t a3 = i_end, a13 = i_end;
   for (size_t i = i_start; i < i_end; ++i) {
-    if (seg.dropout[i])
-      ++seg.n_dropouts_in_span;
+    if (!std::isfinite(sm[i])) continue;
+    if (a3 == i_end && sm[i] <= s0 - kSettlingSkipDb / kDbPerNeper) a3 = i;
+    if (sm[i] <= s0 - kSettlingRateEndDb / kDbPerNeper) {
+      a13 = i;
+      break;
+    }
+  }
+  if (!(a3 < i_end && a13 > a3 + kMinSettlingRateSamples)) return i_start;
+  // Time of the peak local rate within the first 3 dB (window centre).
+  const size_t w = std::max<size_t>(kMinRateWindow, n / kRateWindowDivisor);
+  double peak = slopeOver(t, sm, dropout, a3, a13);  // negative: ln A falls
+  double t_peak = drive_off_s;
+  for (size_t i = i_start; i + w < a3; ++i) {
+    const double sl = slopeOver(t, sm, dropout, i, i + w);
+    if (sl < peak) peak = sl, t_peak = 0.5 * (t[i] + t[i + w - 1]);
+  }
+  const double t_skip = drive_off_s + kSettlingTimeFactor * std::max(0.0, t_peak - drive_off_s);
+  size_t i_new = i_start;
+  while (i_new < a3 && t[i_new] < t_skip) ++i_new;
+  return i_new;
+}
+
+/// Step 4's span [i_start, i_end): its counts, its times and its decay from the smoothed
+/// envelope.
+void setSmoothedSpan(const std::vector<double>& t, const std::vector<double>& sm, size_t i_start,
+                     size_t i_end, RingdownSegment* seg) {
+  seg->i_start = i_start;
+  seg->i_end = i_end;
+  for (size_t i = i_start; i < i_end; ++i) {
+    if (seg->dropout[i])
+      ++seg->n_dropouts_in_span;
     else
-      ++seg.n_used;
+      ++seg->n_used;
   }
   // Decay over the span from the smoothed envelope.
   double s_first = std::numeric_limits<double>::quiet_NaN(), s_last = s_first;
@@ -435,11 +556,18 @@ RingdownSegment segmentWindow(const RingdownEnvelope& env,
       if (!std::isfinite(s_first)) s_first = sm[i];
       s_last = sm[i];
     }
-  seg.decay_db = (s_first - s_last) * kDbPerNeper;
+  seg->decay_db = (s_first - s_last) * kDbPerNeper;
   if (i_end > i_start) {
-    seg.t_start_s = t[i_start];
-    seg.t_end_s = t[i_end - 1];
+    seg->t_start_s = t[i_start];
+    seg->t_end_s = t[i_end - 1];
   }
+}
+
+/// Step 4's sentence: the plateau (at best_c) or none, the floor confirmed, suspected or none,
+/// the drop-outs and the decay.
+std::string segmentWhy(const RingdownEnvelope& env, const RingdownSegment& seg, double best_c,
+                       double margin_db) {
+  const auto& t = env.t_s;
   std::ostringstream why;
   why.precision(4);
   const std::string unit = env.from_db ? " dB" : " dB re 1 unit";
@@ -459,11 +587,77 @@ RingdownSegment segmentWindow(const RingdownEnvelope& env,
         << " dB above that level at " << seg.t_end_s << " s";
   else
     why << "; no noise floor reached (decay to the end, " << seg.t_end_s << " s)";
-  why << "; " << seg.n_dropouts_in_span << " drop-outs left out of " << (i_end - i_start)
+  why << "; " << seg.n_dropouts_in_span << " drop-outs left out of " << (seg.i_end - seg.i_start)
       << " samples; decay " << seg.decay_db << " dB";
-  seg.why = why.str();
-  if (seg.n_used < 8 ||
-      !(seg.decay_db >= std::max(options.min_decay_db, 10.0 * seg.noise_sd_log * kDbPerNeper)))
+  return why.str();
+}
+
+/// Steps 1-4 of the header on a window that holds one ring-down.
+RingdownSegment segmentWindow(const RingdownEnvelope& env,
+                              const RingdownSegmentationOptions& options) {
+  const auto problems = options.validate();
+  if (!problems.empty()) throw InputError("ring-down segmentation: " + problems.front());
+  const size_t n = env.size();
+  if (n < kMinSamples)
+    throw InputError("ring-down envelope has " + std::to_string(n) + " samples (< 8)");
+  const auto& t = env.t_s;
+  const auto& y = env.log_amplitude;
+  RingdownSegment seg;
+  seg.dropout.assign(n, false);
+  for (size_t i = 0; i < n; ++i) seg.dropout[i] = !std::isfinite(y[i]);
+
+  // 1. Drop-outs against the running median (window 11), robust scale from differences.
+  markDropouts(y, n, options, &seg);
+  const int half = std::max(kMinSmoothHalf, static_cast<int>(n / kSmoothDivisor));
+  const std::vector<double> sm = runningMedian(y, seg.dropout, half);
+  const EnvelopePeak peak = smoothedPeak(sm, n);
+
+  // 2. Noise floor: from 25 dB above the level of the record's last tenth to the end, a straight
+  // decay plus an additive floor beats the straight decay, with the floor above its continuation.
+  const FloorCut floor_cut = readFloor(env, sm, n, peak, options, &seg);
+  const size_t i_end = floor_cut.i_end;
+  const double margin_db = floor_cut.margin_db;
+
+  // 3. Drive switch-off: the plateau level c0 is the median of the smoothed envelope over the first
+  // twentieth (a running median keeps the corner sharp); the decay starts where the envelope first
+  // falls delta = max(6 sd, 0.1 dB) below it. A plateau exists when that crossing comes later than
+  // three times the time the decay takes to fall by delta.
+  const size_t n_head = std::min(n, std::max<size_t>(kMinHeadSamples, n / kHeadDivisor));
+  std::vector<double> head;
+  for (size_t i = 0; i < n_head; ++i)
+    if (std::isfinite(sm[i])) head.push_back(sm[i]);
+  const double c0 = median(head);
+  const double delta_noise =
+      std::max(kSwitchOffSd * seg.noise_sd_log, kSwitchOffMinDb / kDbPerNeper);
+  const SwitchOffInput in{t, sm, seg.dropout, n, n_head, i_end, c0};
+  // A drive level that creeps by a few tenths of a dB (an oscillator's amplitude loop on a real
+  // export, D060 of the development set: 0.6 dB over 1.6 s) crosses a noise-sized threshold on the
+  // plateau, where nothing decays after it: then the switch-off is read 1 dB below the plateau.
+  SwitchOff so = readSwitchOff(in, delta_noise);
+  if (!so.has_plateau && !so.falling) {
+    const SwitchOff wide = readSwitchOff(in, std::max(delta_noise, kWideSwitchOffDb / kDbPerNeper));
+    if (wide.has_plateau) so = wide;
+  }
+  const double delta = so.delta;
+  const size_t i_cross = so.i_cross;
+  const double s_after = so.s_after;
+  seg.has_plateau = so.has_plateau;
+  seg.drive_off_s = seg.has_plateau ? t[i_cross] - delta / s_after : t.front();
+  seg.plateau_log_amplitude = c0;
+  const double best_c = c0;
+  size_t i_start = seg.has_plateau ? i_cross : 0;
+  // Detector settling: the first decibels, while the detector's filter catches up, are skipped.
+  i_start = settledStart(t, sm, seg.dropout, n, i_start, i_end, seg.drive_off_s);
+
+  // 4. Refusal: too short a span, too little decay.
+  seg.floor_margin_db = margin_db;
+  if (i_end <= i_start + kMinSamples)
+    throw AnalysisError("ring-down: no decay above the noise floor");
+  setSmoothedSpan(t, sm, i_start, i_end, &seg);
+  seg.why = segmentWhy(env, seg, best_c, margin_db);
+  if (seg.n_used < kMinSamples ||
+      !(seg.decay_db >=
+        std::max(options.min_decay_db, kMinDecaySd * seg.noise_sd_log * kDbPerNeper)))
     throw AnalysisError("ring-down: no decay to fit (" + seg.why + ")");
   return seg;
 }
