@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cvg_bench/core/io/response_record.h"
+#include "cvg_bench/core/single_mode/one_mode_value.h"
 #include "cvg_bench/core/single_mode/response_model.h"
 
 namespace cvg_bench {
@@ -25,11 +26,6 @@ struct ResponseFitOptions {
   /// Relative singular value (column-scaled Jacobian) under which a direction counts as not
   /// determined by the data.
   double rank_tolerance = 1e-9;
-};
-
-struct ResponseValue {
-  double value = 0.0, std = 0.0, ci_low = 0.0, ci_high = 0.0;
-  int dof = 0;  ///< degrees of freedom of the interval's Student t
 };
 
 /// A linear Lorentzian fitted to one drive level alone (the initialiser and the adequacy

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "cvg_bench/core/single_mode/one_mode_value.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
 #include "cvg_bench/core/single_mode/ringdown_segmentation.h"
 
@@ -40,16 +41,6 @@ struct RingdownFitOptions {
   /// false: parameters and residuals only (no covariance, no Q against amplitude).
   bool details = true;
   std::vector<std::string> validate() const;
-};
-
-/// A value with its standard error, interval, and the Cramer-Rao standard error (0 when none).
-struct RingdownValue {
-  double value = 0.0, std = 0.0, ci_low = 0.0, ci_high = 0.0, crb_std = 0.0;
-  /// Q and Q0 only (ringdown_span_spread.h): the span choice's part and the total; NaN unset.
-  double std_span = std::numeric_limits<double>::quiet_NaN();
-  double std_total = std::numeric_limits<double>::quiet_NaN();
-  double ci_total_low = std::numeric_limits<double>::quiet_NaN();
-  double ci_total_high = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Local Q over one amplitude bin (a straight ln A fit there, HAC interval).
