@@ -4,7 +4,7 @@
 set -euo pipefail
 
 PACKAGES=(
-  build-essential cmake make g++ clang-format
+  build-essential cmake make g++ clang-format catkin-lint
   catkin python3-catkin-pkg ros-core-dev ros-message-generation ros-message-runtime
   ros-std-msgs ros-std-srvs ros-geometry-msgs ros-diagnostic-msgs
   librosbag-dev python3-rosbag librostest-dev python3-rostest python3-rospy python3-roslib

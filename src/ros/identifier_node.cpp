@@ -12,7 +12,7 @@
 #include "cvg_bench/DriftRate.h"
 #include "cvg_bench/ModelEstimate.h"
 #include "cvg_bench/core/diagnose/explanation.h"
-#include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/report/explain_json.h"

@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cvg_bench/core/estimate/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/free_decay_regression.h"
-#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
+#include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
@@ -16,10 +16,10 @@ StreamingFreeDecayRls::StreamingFreeDecayRls(const IdentificationOptions& option
       model_(options.model, ExperimentMode::kFreeDecay),
       qr_(model_.numParameters()),
       rls_(model_.numParameters(), options.rls_forgetting) {
-  for (const auto& ext : model_.extensionNames())
-    if (ext == "cm_rate")
-      throw InputError(
-          "the recursive identifier cannot take cm_rate (a time-varying term); use ls");
+  for (const auto& term : model_.terms())
+    if (term->isTimeVarying())
+      throw InputError("the recursive identifier cannot take " + term->name() +
+                       " (a time-varying term); use ls");
   const int k = model_.numParameters();
   init_blocks_ = options.rls_init_blocks > 0 ? options.rls_init_blocks : std::max(2 * k, 8);
 }

@@ -11,7 +11,7 @@
 #include "cli_args.h"
 #include "cvg_bench/core/diagnose/drift_measurement.h"
 #include "cvg_bench/core/estimate/derived_quantities.h"
-#include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
 #include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
 #include "cvg_bench/core/model/errors.h"

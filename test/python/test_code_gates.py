@@ -1,6 +1,7 @@
 """Gates on the project's own code (issue #23): every tracked C++ file is as the repository's
 .clang-format writes it (`make format` fixes it); no function in src/ is longer than 120 lines
-(signature to closing brace; a reader holds one step at a time: split long ones into named steps). The warning gate is in CMakeLists.txt
+(signature to closing brace; a reader holds one step at a time: split long ones into named steps);
+catkin_lint finds no error in the package (Debian's catkin-lint, offline: no rosdep here). The warning gate is in CMakeLists.txt
 (-Werror with GCC on the project's sources). Skipped outside a git checkout or without
 clang-format."""
 import os
@@ -11,6 +12,7 @@ import unittest
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 FORMAT = shutil.which("clang-format") or shutil.which("clang-format-14")
+CATKIN_LINT = shutil.which("catkin_lint")
 
 
 def tracked_cpp():
@@ -41,6 +43,16 @@ def function_lengths(path):
                 if kind == "block" and all(k == "container" for k, _ in stack):
                     out.append((i - start + 1, start + 1))
     return out
+
+
+@unittest.skipUnless(CATKIN_LINT, "catkin_lint absent (scripts/install_deps.sh installs it)")
+class CatkinLint(unittest.TestCase):
+    def test_the_package_has_no_catkin_lint_error(self):
+        p = subprocess.run([CATKIN_LINT, "--offline", "-q", ROOT], capture_output=True, text=True,
+                           timeout=300)
+        errors = [line for line in (p.stdout + p.stderr).splitlines() if ": error:" in line]
+        self.assertEqual(errors, [])
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
 
 
 class FunctionLength(unittest.TestCase):

@@ -4,8 +4,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "cvg_bench/core/estimate/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/estimate.h"
+#include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
 #include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {

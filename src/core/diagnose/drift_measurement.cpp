@@ -6,7 +6,7 @@
 #include <limits>
 #include <sstream>
 
-#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"

@@ -8,8 +8,8 @@
 
 #include "cvg_bench/core/diagnose/model_diagnosis.h"
 #include "cvg_bench/core/diagnose/parallel_tasks.h"
-#include "cvg_bench/core/estimate/fitted_residual_ar1.h"
 #include "cvg_bench/core/estimate/least_squares_solver.h"
+#include "cvg_bench/core/estimate/uncertainty/fitted_residual_ar1.h"
 
 namespace cvg_bench {
 namespace {

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <sstream>
 
-#include "cvg_bench/core/estimate/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/internal/hac_slope.h"
-#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
+#include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/sample_median.h"
 

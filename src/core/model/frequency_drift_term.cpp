@@ -18,6 +18,7 @@ class FrequencyDriftTerm : public ModelTerm {
              "phase-rate (tangential) residual growing linearly with time", false, true, false, 4}};
   }
   bool appliesTo(ExperimentMode mode) const override { return mode == ExperimentMode::kFreeDecay; }
+  bool isTimeVarying() const override { return true; }
   void averagedColumns(const Eigen::Vector4d& q, const SlowContext& c,
                        Eigen::Ref<Eigen::MatrixXd> d) const override {
     d(0, 0) = c.t_s * q[1];

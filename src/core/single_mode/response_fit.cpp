@@ -11,7 +11,7 @@
 #include <numeric>
 
 #include "cvg_bench/core/estimate/dense_solver_options.h"
-#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/gamma_nl_conventions.h"
 

@@ -8,9 +8,9 @@
 #include <optional>
 #include <sstream>
 
+#include "cvg_bench/core/estimate/uncertainty/ar_noise_covariance.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
-#include "cvg_bench/core/single_mode/ringdown_intervals.h"
 #include "cvg_bench/core/single_mode/ringdown_models.h"
 #include "cvg_bench/core/single_mode/ringdown_span_spread.h"
 
@@ -196,8 +196,8 @@ double ringdownAddedTermsP(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, i
   // detector's slow floor noise late). Either alone flags clean records where the other holds.
   double p_value = 0.0;
   for (int local = 0; local < 2; ++local) {
-    const RingdownCovariance cov =
-        local ? ringdownCovarianceLocalAr(X, e, kLackOfFitBlocks) : ringdownCovariance(X, e, false);
+    const ArNoiseCovariance cov =
+        local ? arNoiseCovarianceLocal(X, e, kLackOfFitBlocks) : arNoiseCovariance(X, e, false);
     const Eigen::MatrixXd C = cov.covariance.bottomRightCorner(q, q);
     const double w = bq.dot(C.colPivHouseholderQr().solve(bq));
     if (!std::isfinite(w)) continue;  // no usable noise model: that one shows nothing
@@ -313,7 +313,7 @@ double whitenedSse(const std::vector<double>& ar, const RingdownFit& f) {
   std::vector<double> e(m);
   for (size_t i = 0; i < m; ++i) e[i] = std::sqrt(f.weight[i]) * (f.log_amplitude[i] - f.fitted[i]);
   double sse = 0.0;
-  for (double w : ringdownArWhiten(ar, e)) sse += w * w;
+  for (double w : arWhiten(ar, e)) sse += w * w;
   return sse;
 }
 

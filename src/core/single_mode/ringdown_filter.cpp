@@ -8,9 +8,9 @@
 #include <sstream>
 
 #include "cvg_bench/core/estimate/numeric_least_squares.h"
+#include "cvg_bench/core/estimate/uncertainty/ar_noise_covariance.h"
 #include "cvg_bench/core/model/sample_median.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
-#include "cvg_bench/core/single_mode/ringdown_intervals.h"
 #include "cvg_bench/core/single_mode/ringdown_models.h"
 
 namespace cvg_bench {
@@ -379,7 +379,7 @@ RingdownFilteredFit fitRingdownThroughFilter(const RingdownEnvelope& env,
   res(out.p, r);
   std::vector<double> e(r.data(), r.data() + r.size());
   double s = 0.0;
-  for (double v : ringdownArWhiten(ar, e)) s += v * v;
+  for (double v : arWhiten(ar, e)) s += v * v;
   out.sse_whitened = s;
   return out;
 }

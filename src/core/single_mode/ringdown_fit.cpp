@@ -7,11 +7,11 @@
 #include <sstream>
 
 #include "cvg_bench/core/estimate/numeric_least_squares.h"
-#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/estimate/uncertainty/ar_noise_covariance.h"
+#include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/sample_median.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
-#include "cvg_bench/core/single_mode/ringdown_intervals.h"
 #include "cvg_bench/core/single_mode/ringdown_laws.h"
 #include "cvg_bench/core/single_mode/ringdown_models.h"
 
@@ -414,13 +414,14 @@ void storeSamples(const RingdownEnvelope& env, const std::vector<size_t>& used,
   }
 }
 
-/// Step 7: intervals under the residuals' serial correlation (ringdown_intervals.h); the
-/// Cramer-Rao bound for white noise beside them. Returns the intervals' quantile z.
+/// Step 7: intervals under the residuals' serial correlation
+/// (estimate/uncertainty/ar_noise_covariance.h); the Cramer-Rao bound for white noise beside them.
+/// Returns the intervals' quantile z.
 double storeCovariance(const RingdownLaw& law, const Data& d, const Eigen::VectorXd& r,
                        const RingdownFitOptions& options, RingdownFit& fit) {
   Eigen::MatrixXd J;
   jacobian(law, fit.p, d, fit.floor_rel, J);
-  const RingdownCovariance rc = ringdownCovariance(J, r);
+  const ArNoiseCovariance rc = arNoiseCovariance(J, r);
   fit.rank = rc.rank;
   fit.rho1 = rc.rho1;
   fit.cov_crb = rc.crb;
@@ -450,7 +451,7 @@ RingdownQBin qBin(const Data& d, const std::vector<int>& idx, const RingdownFitO
   lvl /= m;
   const Eigen::VectorXd c = X.colPivHouseholderQr().solve(Y);
   const Eigen::VectorXd res = Y - X * c;
-  const RingdownCovariance hb = ringdownCovariance(X, res);
+  const ArNoiseCovariance hb = arNoiseCovariance(X, res);
   RingdownValue rate;
   const double zb =
       studentQuantile(options.confidence, std::max(1, static_cast<int>(hb.student_df)));

@@ -10,8 +10,8 @@
 
 #include "cvg_bench/core/demod/demodulator.h"
 #include "cvg_bench/core/diagnose/explanation.h"
-#include "cvg_bench/core/diagnose/residual_correlation.h"
 #include "cvg_bench/core/diagnose/residual_noise_model.h"
+#include "cvg_bench/core/estimate/uncertainty/long_run_variance.h"
 #include "cvg_bench/core/model/resonator_preset.h"
 #include "cvg_bench/core/simulate/experiment_runner.h"
 

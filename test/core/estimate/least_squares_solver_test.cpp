@@ -7,7 +7,7 @@
 #include <Eigen/QR>
 #include <random>
 
-#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {

@@ -50,6 +50,23 @@ TEST(ModelTermRegistry, EveryTermIsACandidateWhereItApplies) {
   }
 }
 
+TEST(ModelTermRegistry, TimeVaryingTermsAreTheTermsWhoseForceDependsOnTime) {
+  const Eigen::Vector4d q(0.31, 0.52, -0.17, 0.23);
+  int time_varying = 0;
+  for (const auto& name : knownModelTermNames()) {
+    const ModelTermPtr t = makeModelTerm(name);
+    SlowContext early, late;
+    early.t_s = 1.0;
+    late.t_s = 5.0;
+    Eigen::MatrixXd a(4, t->numParameters()), b(4, t->numParameters());
+    t->averagedColumns(q, early, a);
+    t->averagedColumns(q, late, b);
+    EXPECT_EQ(t->isTimeVarying(), (a - b).norm() > 1e-12 * a.norm()) << name;
+    time_varying += t->isTimeVarying();
+  }
+  EXPECT_EQ(time_varying, 1);  // cm_rate
+}
+
 TEST(ModelTermRegistry, AmplitudeLawsAreTheTermsWhoseForceGrowsFasterThanTheAmplitude) {
   for (const auto& name : knownModelTermNames()) {
     const ModelTermPtr t = makeModelTerm(name);

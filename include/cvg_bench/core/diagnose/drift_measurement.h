@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
 #include "cvg_bench/core/io/records.h"
 
 namespace cvg_bench {

@@ -5,7 +5,7 @@
 // Criterion of a subset S with k_S added terms, from residuals r (N values) of its fit:
 //   IC(S) = n_eff ln(RSS_S / N) + k_S * penalty,   n_eff = N / c,
 //   penalty = max(ln n_eff, chi^2_1 quantile at 1 - alpha / m)      (m = candidates)
-// c = 1 + 2 sum_l rho_l is the long-run variance factor of the residuals (residual_correlation.h):
+// c = 1 + 2 sum_l rho_l is the long-run variance factor of the residuals (long_run_variance.h):
 // correlated noise (AR(1) on q, the demodulator's filter, the lag-2 structure of (2.8)) makes
 // n ln(RSS_0 / RSS_1) ~ c chi^2 under a null term, so n_eff ln(...) ~ chi^2 again. The penalty is
 // BIC's ln n_eff, but never below the Bonferroni chi^2 quantile so that clean records select a null

@@ -77,7 +77,7 @@ struct Estimate {
   std::string interval_method_id;
   double residual_lag1 = 0.0;           ///< lag-1 correlation of the residuals (one time step)
   double residual_lag1_expected = 0.0;  ///< its value under independent noise
-  double residual_lag1_z = 0.0;         ///< the test statistic (residual_correlation.h)
+  double residual_lag1_z = 0.0;         ///< the test statistic (residual_serial_correlation.h)
   bool residual_correlated = false;     ///< |z| > 2.576: the intervals account for it
   std::string noise_model;              ///< e.g. "AR(1) rho = 0.9 (fitted)"
 

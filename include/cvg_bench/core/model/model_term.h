@@ -92,6 +92,10 @@ class ModelTerm {
   /// amplitude cannot tell it from the linear terms (identifiability.cpp), and in one free decay
   /// it is tied to time through the decay (explain's caveat, explanation.cpp).
   virtual bool isAmplitudeLaw() const { return false; }
+  /// Its averaged force depends on the time since the record's start (SlowContext::t_s), as
+  /// cm_rate's does: the streaming recursive identifier, whose blocks forget the origin, refuses
+  /// such terms (src/ros/streaming_free_decay_rls.cpp).
+  virtual bool isTimeVarying() const { return false; }
   /// 4 x k columns of the averaged regressor D(q) (2.6)/(3.3).
   virtual void averagedColumns(const Eigen::Vector4d& q, const SlowContext& ctx,
                                Eigen::Ref<Eigen::MatrixXd> cols) const = 0;

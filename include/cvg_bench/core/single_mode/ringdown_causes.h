@@ -118,7 +118,7 @@ double ringdownLackOfFitP(const RingdownFit& fit);  ///< ringdownLackOfFit(fit).
 
 /// Wald p-value of the last q columns of X (added terms) in the least-squares fit of r, the larger
 /// of the two under the residuals' single AR noise model and under AR models fitted in contiguous
-/// blocks (ringdown_intervals.h); 1 when X is rank-deficient.
+/// blocks (estimate/uncertainty/ar_noise_covariance.h); 1 when X is rank-deficient.
 double ringdownAddedTermsP(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, int q);
 
 }  // namespace cvg_bench

@@ -8,12 +8,12 @@
 // (relative noise); a growth as 1/A is additive noise on the amplitude (with the floor). The
 // weights are 1 / s^2 at each sample's fitted level either way.
 //
-// Intervals: ringdown_intervals.h (serial correlation detected in the weighted ln A residuals ->
-// sandwich under an AR(p) noise model, else white), which stays honest when the residuals are
-// correlated (detector filters, drift); the Cramer-Rao bound (white noise with the chosen error
-// model: sigma^2 (J'WJ)^-1) is reported beside it. cov_hac holds the honest covariance. Q = pi f
-// tau (tau the amplitude time constant) with a confidence interval mapped from that of the rate
-// (asymmetric), std by the delta method.
+// Intervals: estimate/uncertainty/ar_noise_covariance.h (serial correlation detected in the
+// weighted ln A residuals -> sandwich under an AR(p) noise model, else white), which stays honest
+// when the residuals are correlated (detector filters, drift); the Cramer-Rao bound (white noise
+// with the chosen error model: sigma^2 (J'WJ)^-1) is reported beside it. cov_hac holds the honest
+// covariance. Q = pi f tau (tau the amplitude time constant) with a confidence interval mapped from
+// that of the rate (asymmetric), std by the delta method.
 #pragma once
 
 #include <Eigen/Core>

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cvg_bench/core/estimate/hac_covariance.h"
-#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/estimate/uncertainty/hac_covariance.h"
+#include "cvg_bench/core/estimate/uncertainty/student_t.h"
 
 namespace cvg_bench {
 

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/sweep_noise_ar1.h"
+#include "cvg_bench/core/estimate/uncertainty/sweep_noise_ar1.h"
 
 #include <Eigen/Dense>
 #include <Eigen/QR>
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "cvg_bench/core/estimate/fitted_residual_ar1.h"
+#include "cvg_bench/core/estimate/uncertainty/fitted_residual_ar1.h"
 
 namespace cvg_bench {
 namespace {

@@ -1,7 +1,7 @@
-// Known-answer tests of the ring-down interval machinery (ringdown_intervals.h): the exact AR
-// whitening of the explain criterion and the block check's coverage under noise whose correlation
-// changes along the record.
-#include "cvg_bench/core/single_mode/ringdown_intervals.h"
+// Known-answer tests of the ring-down interval machinery
+// (estimate/uncertainty/ar_noise_covariance.h): the exact AR whitening of the explain criterion and
+// the block check's coverage under noise whose correlation changes along the record.
+#include "cvg_bench/core/estimate/uncertainty/ar_noise_covariance.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <cmath>
 #include <random>
 
-#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/estimate/uncertainty/student_t.h"
 
 namespace cvg_bench {
 namespace {
@@ -17,7 +17,7 @@ namespace {
 TEST(RingdownIntervals, ArWhiteningKeepsTheFirstSamples) {
   const std::vector<double> e = {1.0, 2.0, -1.0, 0.5};
   // AR(1), a = 0.8: the first sample scaled by sqrt(1 - a^2), then e_i - a e_{i-1}.
-  const std::vector<double> w1 = ringdownArWhiten({0.8}, e);
+  const std::vector<double> w1 = arWhiten({0.8}, e);
   ASSERT_EQ(w1.size(), e.size());
   EXPECT_NEAR(w1[0], 0.6, 1e-9);
   EXPECT_NEAR(w1[1], 2.0 - 0.8, 1e-9);
@@ -25,7 +25,7 @@ TEST(RingdownIntervals, ArWhiteningKeepsTheFirstSamples) {
   // AR(2), a = (0.5, 0.2): rho1 = a1 / (1 - a2) = 0.625, rho2 = a1 rho1 + a2 = 0.5125, innovation
   // variance / gamma_0 = 1 - a1 rho1 - a2 rho2 = 0.585; sample 1 predicted by rho1 e_0 with
   // variance 1 - rho1^2.
-  const std::vector<double> w2 = ringdownArWhiten({0.5, 0.2}, e);
+  const std::vector<double> w2 = arWhiten({0.5, 0.2}, e);
   EXPECT_NEAR(w2[0], std::sqrt(0.585), 1e-6);
   EXPECT_NEAR(w2[1], (2.0 - 0.625) * std::sqrt(0.585 / (1.0 - 0.625 * 0.625)), 1e-6);
   EXPECT_NEAR(w2[2], -1.0 - 0.5 * 2.0 - 0.2 * 1.0, 1e-9);
@@ -41,7 +41,7 @@ TEST(RingdownIntervals, ArWhiteningKeepsTheFirstSamples) {
     if (i >= 0) x[i] = v;
   }
   double s = 0.0;
-  for (double v : ringdownArWhiten({0.5, 0.2}, x)) s += v * v;
+  for (double v : arWhiten({0.5, 0.2}, x)) s += v * v;
   EXPECT_NEAR(s / n, 1.0, 0.04);
 }
 
@@ -71,8 +71,8 @@ TEST(RingdownIntervals, BlockCheckKeepsCoverageWhenTheCorrelationChanges) {
     const Eigen::VectorXd e = changingNoise(rng, n);  // truth: slope 0
     const Eigen::VectorXd b = J.colPivHouseholderQr().solve(e);
     const Eigen::VectorXd res = e - J * b;
-    const RingdownCovariance c = ringdownCovariance(J, res);
-    const RingdownCovariance m = ringdownCovariance(J, res, false);
+    const ArNoiseCovariance c = arNoiseCovariance(J, res);
+    const ArNoiseCovariance m = arNoiseCovariance(J, res, false);
     const double z = studentQuantile(0.95, std::max(1, static_cast<int>(c.student_df)));
     const double zm = studentQuantile(0.95, std::max(1, static_cast<int>(m.student_df)));
     covered += std::fabs(b(1)) <= z * std::sqrt(c.covariance(1, 1));
@@ -95,7 +95,7 @@ TEST(RingdownIntervals, LocalArCovarianceIsFiniteWithAStepInABlock) {
     J(i, 0) = 1.0, J(i, 1) = static_cast<double>(i) / n;
     r(i) = (i > 1000 ? 1.0 : 0.0) + (i > 1000 ? 2e-3 * (i - 1000) : 0.0) + g(rng);
   }
-  const RingdownCovariance c = ringdownCovarianceLocalAr(J, r, 4);
+  const ArNoiseCovariance c = arNoiseCovarianceLocal(J, r, 4);
   EXPECT_TRUE(c.covariance.allFinite());
   EXPECT_GT(c.covariance(1, 1), 0.0);
 }

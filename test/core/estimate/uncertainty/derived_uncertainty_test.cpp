@@ -1,11 +1,11 @@
 // Delta-method intervals of derived quantities and of the drift rate (5.9).
-#include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 

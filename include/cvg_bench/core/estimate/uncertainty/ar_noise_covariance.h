@@ -25,7 +25,7 @@
 
 namespace cvg_bench {
 
-struct RingdownCovariance {
+struct ArNoiseCovariance {
   Eigen::MatrixXd covariance;  ///< p x p, the honest one (equal to crb when white)
   Eigen::MatrixXd crb;         ///< sigma^2 (J'J)^-1, white noise
   bool correlated = false;
@@ -44,22 +44,22 @@ struct RingdownCovariance {
 /// (sigma^2 = SSE / (n - p)).
 /// block_check: step 4 (intervals); false gives steps 1-3 only (the lack-of-fit test, whose power
 /// against a misfit localized in time the blocks would absorb).
-RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& jacobian,
-                                      const Eigen::VectorXd& residuals, bool block_check = true);
+ArNoiseCovariance arNoiseCovariance(const Eigen::MatrixXd& jacobian,
+                                    const Eigen::VectorXd& residuals, bool block_check = true);
 
 /// Steps 1-3 with the noise model fitted separately in up to `blocks` contiguous blocks (at least
 /// 150 samples each): a block-diagonal noise covariance, each block's variance and AR(p <= 12,
 /// BIC) correlation its own. For the lack-of-fit test, whose covariance
 /// must hold where the noise changes along the record (relative noise early, the detector's slow
 /// floor noise late) without absorbing a misfit as the cluster sandwich would.
-RingdownCovariance ringdownCovarianceLocalAr(const Eigen::MatrixXd& jacobian,
-                                             const Eigen::VectorXd& residuals, int blocks = 4);
+ArNoiseCovariance arNoiseCovarianceLocal(const Eigen::MatrixXd& jacobian,
+                                         const Eigen::VectorXd& residuals, int blocks = 4);
 
 /// One-step prediction errors of e under the stationary AR noise model a_1..a_p, in units of the
 /// innovation sd (generalized least squares): the first p samples are predicted from the ones
 /// before them only (Durbin-Levinson on the model's autocorrelation) and scaled by their larger
 /// prediction variance, not dropped, so a misfit that starts with the span (a fast first stage
 /// of a decay) keeps its weight; from sample p on, e_i - sum_k a_k e_{i-k}.
-std::vector<double> ringdownArWhiten(const std::vector<double>& ar, const std::vector<double>& e);
+std::vector<double> arWhiten(const std::vector<double>& ar, const std::vector<double>& e);
 
 }  // namespace cvg_bench

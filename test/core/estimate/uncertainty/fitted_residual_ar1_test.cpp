@@ -1,7 +1,7 @@
 // fitted_residual_ar1.h: the expectation E[r'Lr] / E[r'r] computed from one backward recursion
 // over J equals the sum of its lag products written out (the header's formula), and the corrected
 // rho recovers an AR(1) coefficient that the fit's residuals understate.
-#include "cvg_bench/core/estimate/fitted_residual_ar1.h"
+#include "cvg_bench/core/estimate/uncertainty/fitted_residual_ar1.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/free_decay_noise_propagation.h"
+#include "cvg_bench/core/estimate/uncertainty/free_decay_noise_propagation.h"
 
 #include <cstring>
 #include <string>

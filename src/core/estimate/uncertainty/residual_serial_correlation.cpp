@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/residual_correlation.h"
+#include "cvg_bench/core/estimate/uncertainty/residual_serial_correlation.h"
 
 #include <cmath>
 

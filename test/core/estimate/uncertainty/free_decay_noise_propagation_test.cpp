@@ -2,7 +2,7 @@
 // sensitivity J = d(equation errors)/d(samples) by central differences through the block generator,
 // then sum_m W_m W_m' = D' J J' D and the noise gain ||J||_F^2. Two records (the record ends carry
 // the O(1) terms), uniform (Simpson) and irregular (trapezoid) times, the largest free-decay model.
-#include "cvg_bench/core/estimate/free_decay_noise_propagation.h"
+#include "cvg_bench/core/estimate/uncertainty/free_decay_noise_propagation.h"
 
 #include <gtest/gtest.h>
 

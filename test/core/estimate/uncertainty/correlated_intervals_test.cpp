@@ -1,4 +1,4 @@
-// Honest intervals under serially correlated noise (residual_correlation.h,
+// Honest intervals under serially correlated noise (residual_serial_correlation.h,
 // correlated_noise_gram.h): the AR(1) fit of the differenced residuals, the correlated
 // sensitivity Gram against its brute-force sum, and Monte Carlo coverage and std/RMS of the
 // free-decay LS intervals (2.7) and of the output-error (Ceres) intervals under AR(1) rho = 0.9
@@ -11,9 +11,9 @@
 #include <random>
 
 #include "cvg_bench/core/estimate/ceres_refinement.h"
-#include "cvg_bench/core/estimate/correlated_noise_gram.h"
 #include "cvg_bench/core/estimate/identification.h"
-#include "cvg_bench/core/estimate/residual_correlation.h"
+#include "cvg_bench/core/estimate/uncertainty/correlated_noise_gram.h"
+#include "cvg_bench/core/estimate/uncertainty/residual_serial_correlation.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "identification_test_support.h"
 

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/fitted_residual_ar1.h"
+#include "cvg_bench/core/estimate/uncertainty/fitted_residual_ar1.h"
 
 #include <algorithm>
 #include <cmath>

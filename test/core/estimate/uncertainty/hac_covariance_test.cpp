@@ -1,7 +1,7 @@
 // HAC covariance (hac_covariance.h): equals the textbook Newey-West sandwich on a small problem,
 // handles stacked blocks, and gives honest 95% intervals under AR(1) rho = 0.9 residuals where the
 // iid formula of (2.11) does not.
-#include "cvg_bench/core/estimate/hac_covariance.h"
+#include "cvg_bench/core/estimate/uncertainty/hac_covariance.h"
 
 #include <gtest/gtest.h>
 

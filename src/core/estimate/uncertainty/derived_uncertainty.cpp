@@ -1,11 +1,11 @@
-#include "cvg_bench/core/estimate/derived_uncertainty.h"
+#include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "cvg_bench/core/estimate/derived_quantities.h"
-#include "cvg_bench/core/estimate/student_t.h"
+#include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/single_mode/ringdown_intervals.h"
+#include "cvg_bench/core/estimate/uncertainty/ar_noise_covariance.h"
 
 #include <Eigen/Dense>
 #include <boost/math/distributions/chi_squared.hpp>
@@ -12,7 +12,7 @@ constexpr int kMaxArOrder = 12;
 constexpr int kLjungBoxLags = 10;
 constexpr int kBlocks = 16;
 
-RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r);
+ArNoiseCovariance arNoiseCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r);
 
 /// Autocorrelations r_1..r_L of x (mean removed).
 std::vector<double> autocorrelation(const Eigen::VectorXd& x, int lags) {
@@ -74,7 +74,7 @@ std::vector<double> arAutocorrelation(const std::vector<double>& a, int max_lag)
 /// Step 4 of the header: each parameter keeps the larger of its standard errors under `out` and
 /// under the cluster sandwich of B contiguous blocks of the scores.
 void blockCheck(const Eigen::MatrixXd& J, const Eigen::VectorXd& r, const Eigen::MatrixXd& jtj_inv,
-                RingdownCovariance& out) {
+                ArNoiseCovariance& out) {
   const int n = static_cast<int>(J.rows()), p = static_cast<int>(J.cols());
   const int B = std::min(kBlocks, n / 10);
   if (B < p + 4 || out.rank < p) return;
@@ -109,9 +109,9 @@ void blockCheck(const Eigen::MatrixXd& J, const Eigen::VectorXd& r, const Eigen:
 
 }  // namespace
 
-RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
-                                      bool block_check) {
-  RingdownCovariance out = ringdownCovarianceModel(J, r);
+ArNoiseCovariance arNoiseCovariance(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
+                                    bool block_check) {
+  ArNoiseCovariance out = arNoiseCovarianceModel(J, r);
   if (!block_check) return out;
   Eigen::MatrixXd jtj_inv = Eigen::MatrixXd::Zero(J.cols(), J.cols());
   if (out.rank == J.cols()) {
@@ -127,8 +127,8 @@ RingdownCovariance ringdownCovariance(const Eigen::MatrixXd& J, const Eigen::Vec
 
 namespace {
 
-RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r) {
-  RingdownCovariance out;
+ArNoiseCovariance arNoiseCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r) {
+  ArNoiseCovariance out;
   const int n = static_cast<int>(J.rows()), p = static_cast<int>(J.cols());
   Eigen::HouseholderQR<Eigen::MatrixXd> hq(J);
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> cq(J);
@@ -223,9 +223,9 @@ RingdownCovariance ringdownCovarianceModel(const Eigen::MatrixXd& J, const Eigen
 
 }  // namespace
 
-RingdownCovariance ringdownCovarianceLocalAr(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
-                                             int blocks) {
-  RingdownCovariance out = ringdownCovarianceModel(J, r);
+ArNoiseCovariance arNoiseCovarianceLocal(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
+                                         int blocks) {
+  ArNoiseCovariance out = arNoiseCovarianceModel(J, r);
   const int n = static_cast<int>(J.rows()), p = static_cast<int>(J.cols());
   const int B = std::max(1, std::min(blocks, n / 150));
   if (out.rank < p || B < 2) return out;
@@ -287,7 +287,7 @@ RingdownCovariance ringdownCovarianceLocalAr(const Eigen::MatrixXd& J, const Eig
   const Eigen::MatrixXd Rinv =
       R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(p, p));
   const Eigen::MatrixXd jtj_inv = Rinv * Rinv.transpose();
-  if (!meat.allFinite()) return ringdownCovarianceModel(J, r);
+  if (!meat.allFinite()) return arNoiseCovarianceModel(J, r);
   out.covariance = jtj_inv * meat * jtj_inv;
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
   std::ostringstream m;
@@ -297,7 +297,7 @@ RingdownCovariance ringdownCovarianceLocalAr(const Eigen::MatrixXd& J, const Eig
   return out;
 }
 
-std::vector<double> ringdownArWhiten(const std::vector<double>& ar, const std::vector<double>& e) {
+std::vector<double> arWhiten(const std::vector<double>& ar, const std::vector<double>& e) {
   const int p = static_cast<int>(ar.size()), n = static_cast<int>(e.size());
   std::vector<double> w(n);
   if (p == 0) return e;

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/correlated_noise_gram.h"
+#include "cvg_bench/core/estimate/uncertainty/correlated_noise_gram.h"
 
 #include <cmath>
 #include <sstream>

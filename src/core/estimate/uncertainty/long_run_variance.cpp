@@ -1,4 +1,4 @@
-#include "cvg_bench/core/diagnose/residual_correlation.h"
+#include "cvg_bench/core/estimate/uncertainty/long_run_variance.h"
 
 #include <algorithm>
 #include <cmath>

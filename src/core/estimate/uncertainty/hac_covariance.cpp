@@ -1,4 +1,4 @@
-#include "cvg_bench/core/estimate/hac_covariance.h"
+#include "cvg_bench/core/estimate/uncertainty/hac_covariance.h"
 
 #include <Eigen/LU>
 #include <Eigen/QR>
