@@ -552,6 +552,8 @@ class BadInputSuite(unittest.TestCase):
             for i in range(60)))
         self.check("response: no resonance (noise only)", ["identify", noise, "--mode",
                    "response"], "refuse", names=("no resonance",))
+        self.check("response: no resonance (noise only), explain", ["explain", noise, "--mode",
+                   "response"], "refuse", names=("no resonance",))
         for args, name in ((["--levels", "0"], "levels"), (["--points", "3"], "points"),
                            (["--q", "-1"], "q"), (["--effect", "kappa=1"], "kappa"),
                            (["--correlation", "1"], "correlation"),

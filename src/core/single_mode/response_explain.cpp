@@ -42,6 +42,7 @@ ResponseExplanation explainResponse(const ResponseData& data, const ResponseExpl
     ResponseCandidate c;
     ResponseFitOptions fo = o.fit;
     fo.level_gain_check = true;
+    fo.require_resonance = false;  // the selected fit only, below
     c.fit = fitResponse(data, t, fo);
     bool all = true;
     const double u_max = c.fit.u.empty() ? 0.0 : *std::max_element(c.fit.u.begin(), c.fit.u.end());
@@ -72,6 +73,7 @@ ResponseExplanation explainResponse(const ResponseData& data, const ResponseExpl
   }
   x.selected_index = pick;
   const ResponseFit& sel = x.candidates[pick].fit;
+  if (o.fit.require_resonance) requireResponseResonance(sel);
   x.selected = sel.terms.name();
   // Adequacy against free Lorentzians per drive level.
   x.adequacy_threshold = o.adequacy_threshold;

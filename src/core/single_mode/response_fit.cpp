@@ -896,16 +896,6 @@ void setIntervals(const ResponseFitOptions& o, ResponseFit* fit) {
   }
 }
 
-/// Step 15. No resonance: a width whose interval reaches zero is not a mode's (noise, or a mode
-/// outside the swept band); nothing of it is reported as a number.
-void requireResonance(const ResponseFit& fit) {
-  const ResponseValue& w = fit.derived.at("width_hz");
-  if (!(w.ci_low > 0.0))
-    throw AnalysisError("no resonance determined by these data: the width's interval [" +
-                        std::to_string(w.ci_low) + ", " + std::to_string(w.ci_high) +
-                        "] Hz reaches zero (noise only, or the mode outside the swept band)");
-}
-
 /// Step 16. The model term's coefficient (gamma_nl_conventions.h): 8 pi times the width growth.
 void addGammaNlTerm(ResponseFit* fit) {
   const auto g = fit->derived.find("width_growth_hz_per_amp2");
@@ -920,6 +910,16 @@ void addGammaNlTerm(ResponseFit* fit) {
 }
 
 }  // namespace
+
+/// Step 15. No resonance: a width whose interval reaches zero is not a mode's (noise, or a mode
+/// outside the swept band); nothing of it is reported as a number.
+void requireResponseResonance(const ResponseFit& fit) {
+  const ResponseValue& w = fit.derived.at("width_hz");
+  if (!(w.ci_low > 0.0))
+    throw AnalysisError("no resonance determined by these data: the width's interval [" +
+                        std::to_string(w.ci_low) + ", " + std::to_string(w.ci_high) +
+                        "] Hz reaches zero (noise only, or the mode outside the swept band)");
+}
 
 ResponseData responseDataOf(const ResponseRecord& r, ResponseKind kind) {
   ResponseData d;
@@ -966,7 +966,7 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   applySandwich(c, sandwich_std, G, &fit);
   if (G >= o.min_sweeps_for_jackknife) jackknifeOverSweeps(c, best, delta, G, sandwich_std, &fit);
   setIntervals(o, &fit);
-  requireResonance(fit);
+  if (o.require_resonance) requireResponseResonance(fit);
   addGammaNlTerm(&fit);
   return fit;
 }

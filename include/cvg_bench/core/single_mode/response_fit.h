@@ -26,6 +26,10 @@ struct ResponseFitOptions {
   /// Relative singular value (column-scaled Jacobian) under which a direction counts as not
   /// determined by the data.
   double rank_tolerance = 1e-9;
+  /// Refuse a fit whose width interval reaches zero (requireResponseResonance). explain's
+  /// candidate fits turn it off and check the selected one only: a rival model's misfit must not
+  /// refuse a record the selected model describes.
+  bool require_resonance = true;
 };
 
 /// A linear Lorentzian fitted to one drive level alone (the initialiser and the adequacy
@@ -58,6 +62,10 @@ struct ResponseFit {
   std::vector<std::string> notes;
   bool converged = false;
 };
+
+/// AnalysisError "no resonance determined by these data" when the width's interval reaches zero
+/// (noise only, or the mode outside the swept band); needs the intervals.
+void requireResponseResonance(const ResponseFit& fit);
 
 /// Points of a record as the fit reads them (sweeps split by splitSweeps).
 ResponseData responseDataOf(const ResponseRecord& record, ResponseKind kind);
