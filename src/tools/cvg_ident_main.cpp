@@ -3,6 +3,9 @@
 
 #include <iostream>
 #include <map>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_ident_commands.h"
@@ -27,6 +30,26 @@ const char* kUsage =
     "            (and batch --merge DIR --out DIR)                  many records, a fleet table\n"
     "exit status: 0 success, 1 analysis failed, 2 bad usage or input\n";
 
+using Command = int (*)(const std::vector<std::string>&);
+
+/// (subcommand, --mode) -> handler for the one-mode records: ring-downs and frequency responses.
+const std::map<std::pair<std::string, std::string>, Command> kOneModeCommands = {
+    {{"identify", "ringdown"}, cvg_bench::tools::runRingdownIdentify},
+    {{"explain", "ringdown"}, cvg_bench::tools::runRingdownExplain},
+    {{"simulate", "ringdown"}, cvg_bench::tools::runRingdownSimulate},
+    {{"identify", "response"}, cvg_bench::tools::runResponseIdentify},
+    {{"explain", "response"}, cvg_bench::tools::runResponseExplain},
+    {{"simulate", "response"}, cvg_bench::tools::runResponseSimulate}};
+
+/// The value of the first `--mode X` or `--mode=X` ("" when none; the subcommand checks it).
+std::string modeOf(const std::vector<std::string>& args) {
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--mode" && i + 1 < args.size()) return args[i + 1];
+    if (args[i].rfind("--mode=", 0) == 0) return args[i].substr(7);
+  }
+  return "";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -34,9 +57,9 @@ int main(int argc, char** argv) {
   // Ceres logs failed evaluations through glog; the tool reports outcomes itself (notes, exit
   // codes).
   FLAGS_minloglevel = google::GLOG_FATAL;
-  const std::map<std::string, int (*)(const std::vector<std::string>&)> commands = {
-      {"simulate", runSimulate}, {"demod", runDemod},     {"identify", runIdentify},
-      {"drift", runDrift},       {"explain", runExplain}, {"batch", runBatch}};
+  const std::map<std::string, Command> commands = {{"simulate", runSimulate}, {"demod", runDemod},
+                                                   {"identify", runIdentify}, {"drift", runDrift},
+                                                   {"explain", runExplain},   {"batch", runBatch}};
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     std::cout << kUsage;
     return argc < 2 ? 2 : 0;
@@ -48,20 +71,9 @@ int main(int argc, char** argv) {
   }
   try {
     const std::vector<std::string> args(argv + 2, argv + argc);
-    // `--mode ringdown`: single-channel ring-downs (cmd_ringdown.cpp).
-    for (size_t i = 0; i + 1 < args.size(); ++i)
-      if ((args[i] == "--mode" && args[i + 1] == "ringdown") || args[i] == "--mode=ringdown") {
-        if (it->first == "identify") return runRingdownIdentify(args);
-        if (it->first == "explain") return runRingdownExplain(args);
-        if (it->first == "simulate") return runRingdownSimulate(args);
-      }
-    // `--mode response`: one mode's frequency response (cmd_response.cpp).
-    for (size_t i = 0; i + 1 < args.size(); ++i)
-      if ((args[i] == "--mode" && args[i + 1] == "response") || args[i] == "--mode=response") {
-        if (it->first == "identify") return runResponseIdentify(args);
-        if (it->first == "explain") return runResponseExplain(args);
-        if (it->first == "simulate") return runResponseSimulate(args);
-      }
+    // The one-mode modes (cmd_ringdown.cpp, cmd_response.cpp) have their own handlers.
+    const auto one_mode = kOneModeCommands.find({it->first, modeOf(args)});
+    if (one_mode != kOneModeCommands.end()) return one_mode->second(args);
     return it->second(args);
   } catch (const cvg_bench::InputError& e) {
     std::cerr << "cvg_ident " << argv[1] << ": error: " << e.what() << "\n";
