@@ -31,7 +31,7 @@ double noiseVariance(const SlowRecord& r, int channel) {
     d2.push_back(r.q[i][channel] - 2.0 * r.q[i - 1][channel] + r.q[i - 2][channel]);
   const double m = median(d2);
   for (double& x : d2) x = std::fabs(x - m);
-  const double s = 1.4826 * median(d2);
+  const double s = kGaussianSdPerMad * median(d2);
   return s * s / 6.0;
 }
 

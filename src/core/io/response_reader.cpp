@@ -17,9 +17,6 @@
 namespace cvg_bench {
 namespace {
 
-/// Fewest response points a record must hold: the one-mode fit's minimum (fitResponse).
-constexpr size_t kMinResponsePoints = 8;
-
 const char* const kKeys[] = {"t", "frequency_hz", "x", "y", "drive", "direction"};
 
 std::string lowerTrimmed(const std::string& s) {

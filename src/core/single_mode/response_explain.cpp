@@ -73,7 +73,7 @@ ResponseExplanation explainResponse(const ResponseData& data, const ResponseExpl
   }
   x.selected_index = pick;
   const ResponseFit& sel = x.candidates[pick].fit;
-  if (o.fit.require_resonance) requireResponseResonance(sel);
+  if (o.fit.require_resonance && o.fit.intervals) requireResponseResonance(sel);
   x.selected = sel.terms.name();
   // Adequacy against free Lorentzians per drive level.
   x.adequacy_threshold = o.adequacy_threshold;

@@ -20,8 +20,6 @@ namespace {
 
 using cd = std::complex<double>;
 
-/// Fewest points fitResponse takes (response_fit.h; the reader asks for as many).
-constexpr size_t kMinResponsePoints = 8;
 /// Largest lag-1 residual correlation the background-slope F test deflates its dof by.
 constexpr double kMaxSlopeTestLag1 = 0.95;
 /// Smallest dof the background-slope F test's denominator is given.

@@ -34,8 +34,6 @@ constexpr int kSamplesPerScatterBin = 12;
 constexpr int kMinSamplesInScatterBin = 6;
 /// Guard of a bin's normalized half-width (time axis of its local fit).
 constexpr double kMinBinHalfWidth = 1e-12;
-/// Median absolute deviation to sd of a Gaussian.
-constexpr double kMadToSd = 1.4826;
 /// Smallest variance a bin reads.
 constexpr double kMinBinVariance = 1e-30;
 /// auto error model: additive when the additive variance at the lowest bin level exceeds this times
@@ -173,7 +171,7 @@ ScatterBins scatterBins(const Data& d) {
     std::vector<double> dd, lv;
     for (int i = 0; i < eq.size(); ++i) dd.push_back(std::fabs(eq(i)));
     for (int i = lo; i < hi; ++i) lv.push_back(d.y(i));
-    const double s = kMadToSd * median(dd);
+    const double s = kGaussianSdPerMad * median(dd);
     bins.var.push_back(std::max(s * s, kMinBinVariance));
     bins.lvl.push_back(median(lv));
   }

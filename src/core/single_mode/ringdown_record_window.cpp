@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 
+#include "cvg_bench/core/model/sample_median.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
 #include "cvg_bench/core/single_mode/ringdown_segmentation.h"
 
@@ -73,7 +74,7 @@ std::vector<Step> stepsAtScale(const std::vector<double>& y_db, long h, double m
     double sd = 0.0;
     if (!d.empty()) {
       std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-      sd = 1.4826 * d[d.size() / 2];
+      sd = kGaussianSdPerMad * d[d.size() / 2];
     }
     const double sharp = jump / std::max(sd, 1e-12);
     if (sharp < 4.0) continue;

@@ -30,8 +30,6 @@ constexpr double kFloorScatter = 0.2;
 constexpr double kFloorScatterRatio = 2.0;
 /// A ring-down needs this many samples: in the envelope, on the peak's grid, in the span (step 4).
 constexpr size_t kMinSamples = 8;
-/// Robust sd over the median absolute deviation (normal noise).
-constexpr double kMadToSd = 1.4826;
 /// Step 1: drop-outs are read against a running median of this half-width (window 11).
 constexpr int kDropoutMedianHalf = 5;
 /// Step 1: the noise scale is read over the record's first half, at least this many samples.
@@ -267,7 +265,7 @@ void markDropouts(const std::vector<double>& y, size_t n,
   // Scale from the first half (plateau and early decay): the floor's log noise is far larger.
   for (size_t i = 1; i < std::max<size_t>(n / 2, kMinScaleSamples); ++i)
     if (!dropout[i] && !dropout[i - 1]) d.push_back(std::fabs(y[i] - y[i - 1]));
-  seg->noise_sd_log = d.empty() ? 0.0 : kMadToSd * median(d) / std::sqrt(2.0);
+  seg->noise_sd_log = d.empty() ? 0.0 : kGaussianSdPerMad * median(d) / std::sqrt(2.0);
   // Depth: 3 dB, or 6 local robust sd (MAD about the running median over 21 samples), so that
   // the Rice dips of additive noise near the floor are not taken for drop-outs.
   const double depth0 =
@@ -281,7 +279,7 @@ void markDropouts(const std::vector<double>& y, size_t n,
     for (size_t j = i >= kLocalMadHalf ? i - kLocalMadHalf : 0;
          j <= std::min(n - 1, i + kLocalMadHalf); ++j)
       if (!dropout[j]) w.push_back(dev[j]);
-    const double local = kMadToSd * median(w);
+    const double local = kGaussianSdPerMad * median(w);
     if (y[i] < med[i] - std::max(depth0, kDropoutLocalSd * local)) dropout[i] = true;
   }
 }
@@ -782,7 +780,7 @@ void trimFloorTail(const RingdownEnvelope& env, RingdownSegment* seg, std::ostri
   auto roughness = [&](size_t a, size_t b) {
     std::vector<double> d;
     for (size_t k = a + 1; k < b; ++k) d.push_back(std::fabs(y[k] - y[k - 1]));
-    return 1.4826 * median(d) / std::sqrt(2.0);
+    return kGaussianSdPerMad * median(d) / std::sqrt(2.0);
   };
   const double r_mid = roughness(q1, q3), r_end = roughness(q3, n);
   if (!(r_end > 1.5 * r_mid)) return;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "cvg_bench/core/model/sample_median.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
 #include "cvg_bench/core/single_mode/ringdown_segmentation.h"
 
@@ -100,7 +101,7 @@ StraightSpan findStraightSpan(const std::vector<double>& t, const std::vector<do
   const std::vector<double> sm = runningMedian(raw, none, std::max<int>(2, m / 300));
   std::vector<double> d;
   for (size_t i = 1; i < m; ++i) d.push_back(std::fabs(raw[i] - raw[i - 1]));
-  const double sd = 1.4826 * medianOf(d) / std::sqrt(2.0);
+  const double sd = kGaussianSdPerMad * medianOf(d) / std::sqrt(2.0);
   const double tol = std::max(o.tol_db, 4.0 * sd);
   const size_t run = std::max<size_t>(3, m / 100);
   // The peak from a wider median (2 % of the grid), so that a glitch of a few samples is none.

@@ -3,11 +3,16 @@
 // level per point, several drive levels and up/down sweeps in one file, in time order.
 #pragma once
 
+#include <cstddef>
 #include <iosfwd>
 #include <string>
 #include <vector>
 
 namespace cvg_bench {
+
+/// Fewest points a response record must hold: the reader refuses fewer, and fitResponse needs as
+/// many.
+constexpr size_t kMinResponsePoints = 8;
 
 /// What the lock-in sees: the displacement or the velocity (i omega x; e.g. a wire's induced
 /// voltage).

@@ -8,6 +8,10 @@
 
 namespace cvg_bench {
 
+/// Standard deviation of Gaussian noise per median absolute deviation (1 / Phi^-1(3/4)): the robust
+/// scale sd = kGaussianSdPerMad * median |d|.
+constexpr double kGaussianSdPerMad = 1.4826;
+
 /// Upper median of v (taken by value: it is reordered); `if_empty` for an empty v.
 inline double sampleMedian(std::vector<double> v,
                            double if_empty = std::numeric_limits<double>::quiet_NaN()) {
