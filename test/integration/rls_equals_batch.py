@@ -18,7 +18,11 @@ from cvg_bench.msg import ModelEstimate
 class RlsEqualsBatch(unittest.TestCase):
     def test_recursive_estimate_reaches_the_batch_estimate(self):
         bag = rospy.get_param("~bag")
-        timeout = rospy.get_param("~timeout_s", 40.0)
+        # A loaded CI machine replays slowly (CI on 294003b: 196 of 401 states in 40 s, ~12 s when
+        # alone), so the bound follows the replay's progress: fail when no new state arrives for
+        # `stall_s`, or at the overall cap `timeout_s`.
+        timeout = rospy.get_param("~timeout_s", 150.0)
+        stall = rospy.get_param("~stall_s", 30.0)
         with rosbag.Bag(bag) as b:
             n = b.get_message_count("/cvg/slow")
         got = {}
@@ -38,12 +42,21 @@ class RlsEqualsBatch(unittest.TestCase):
         while sub.get_num_connections() == 0 and time.monotonic() < deadline:
             time.sleep(0.05)
         player = BagPlayer(bag, ["/cvg/identify"], timeout)
+        finished = False
         try:
-            finished = done.wait(timeout)
+            cap = time.monotonic() + timeout
+            last_progress, last_seen = time.monotonic(), -1
+            while not finished and time.monotonic() < cap:
+                finished = done.wait(1.0)
+                now_seen = max(seen.values()) if seen else 0
+                if now_seen != last_seen:
+                    last_progress, last_seen = time.monotonic(), now_seen
+                elif time.monotonic() - last_progress > stall:
+                    break
         finally:
             player.stop()
-        self.assertTrue(finished, "got %s within %g s, need rls and ls over %d states; most "
-                        "samples seen per method: %s" % (sorted(got), timeout, n, seen))
+        self.assertTrue(finished, "got %s, need rls and ls over %d states (stalled %g s or cap %g "
+                        "s); most samples seen per method: %s" % (sorted(got), n, stall, timeout, seen))
         rls, ls = got["rls"], got["ls"]
         self.assertEqual(rls.names, ls.names)
         self.assertEqual(rls.n_equations, ls.n_equations)
