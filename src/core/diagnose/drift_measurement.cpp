@@ -22,21 +22,6 @@ constexpr int kMaxBins = 3600;
 /// A sample's pattern angle is used where r^2 - k^2 is at least this fraction of r^2 (at r = |k|,
 /// a travelling wave, theta is undefined).
 constexpr double kMinStandingFraction = 1e-4;
-/// Fewest samples with a pattern angle per theta bin.
-constexpr int kMinSamplesPerBin = 4;
-/// The run's theta must cover at least this fraction of its period pi/2 (the text says "3/4").
-constexpr double kMinCoveredFraction = 0.75;
-/// Half-window of the centred moving average of theta, as a fraction of the samples per bin
-/// crossing (about a quarter of a pass), and its bounds in samples.
-constexpr double kHalfWindowFraction = 0.125;
-constexpr int kMinHalfWindow = 2;
-constexpr int kMaxHalfWindow = 50;
-/// A pass counts with at least this many samples (the text says "6 samples or more") ...
-constexpr size_t kMinPassSamples = 6;
-/// ... crossing at least this fraction of the bin.
-constexpr double kMinPassTravel = 0.5;
-/// Largest lag-1 correlation of the pooled noise taken into its AR(1) long-run factor.
-constexpr double kMaxNoiseLag1 = 0.9;
 /// Floor of a pass's slope variance (keeps the inverse-variance weights finite).
 constexpr double kMinPassVariance = 1e-300;
 /// Student's quantile at the noise dof is taken at no more dof than this (normal by then).
@@ -102,13 +87,14 @@ PatternTrack trackPatternAngle(const SlowRecord& record) {
 
 /// The angle theta covers over the run; InputError when the samples are too few for `n_bins` or
 /// the coverage is under 3/4 of the period.
-double checkedCoverage(const SlowRecord& record, const PatternTrack& p, int n_bins) {
-  if (p.t.size() < static_cast<size_t>(kMinSamplesPerBin * n_bins))
+double checkedCoverage(const SlowRecord& record, const PatternTrack& p, int n_bins,
+                       const DriftMeasurementOptions& o) {
+  if (p.t.size() < static_cast<size_t>(o.min_samples_per_bin * n_bins))
     throw InputError(record.source + ": too few samples with a pattern angle for " +
                      std::to_string(n_bins) + " theta bins");
   const double covered =
       *std::max_element(p.th.begin(), p.th.end()) - *std::min_element(p.th.begin(), p.th.end());
-  if (covered < kMinCoveredFraction * M_PI / 2)
+  if (covered < o.min_covered_fraction * M_PI / 2)
     throw InputError(
         record.source + ": the pattern angle covers " + std::to_string(covered * 180 / M_PI) +
         " deg, under 3/4 of its period (90 deg): walk it further to measure theta'(theta)");
@@ -130,10 +116,10 @@ struct ThetaBins {
 /// bin by noise and drops those pushed out, which biases every slope low by a fraction of the
 /// whole rate (walk included; quartz at k0 = 0.1: 2-3 of a pass's interval). The window is about
 /// a quarter of a pass (2 .. 50 samples each side): its half-width.
-int halfWindow(double covered, double width, size_t n_samples) {
+int halfWindow(double covered, double width, size_t n_samples, const DriftMeasurementOptions& o) {
   const double crossings = std::max(1.0, covered / width);
-  return std::clamp(static_cast<int>(kHalfWindowFraction * n_samples / crossings), kMinHalfWindow,
-                    kMaxHalfWindow);
+  return std::clamp(static_cast<int>(o.half_window_fraction * n_samples / crossings),
+                    o.min_half_window, o.max_half_window);
 }
 
 /// The centred moving average of `th` over up to `half` samples each side (the selection angle).
@@ -197,7 +183,7 @@ void fitPass(const PatternTrack& p, size_t start, size_t end, int b, double walk
 /// Cuts the run into runs of consecutive samples whose selection angle lies in one bin; those
 /// that count as passes are fitted.
 PassSet measurePasses(const PatternTrack& p, const std::vector<double>& sel, const ThetaBins& bins,
-                      double walk_rad_s) {
+                      double walk_rad_s, const DriftMeasurementOptions& o) {
   PassSet set;
   set.samples.assign(bins.n, 0);
   size_t start = 0;
@@ -208,7 +194,7 @@ PassSet measurePasses(const PatternTrack& p, const std::vector<double>& sel, con
     // A pass counts when it crosses at least half the bin (fragments at the record's ends and
     // noise-driven re-entries would give slopes of a few samples).
     const double travel = std::abs(sel[i - 1] - sel[start]);
-    if (i - start >= kMinPassSamples && travel >= kMinPassTravel * bins.width)
+    if (i - start >= o.min_pass_samples && travel >= o.min_pass_travel * bins.width)
       fitPass(p, start, i, b, walk_rad_s, &set);
     start = i;
   }
@@ -223,10 +209,10 @@ struct PooledNoise {
   }
 };
 
-PooledNoise poolNoise(const PassSet& set) {
+PooledNoise poolNoise(const PassSet& set, double max_lag1) {
   PooledNoise noise;
   noise.s2 = set.noise_dof > 0 ? set.sse / static_cast<double>(set.noise_dof) : 0.0;
-  noise.rho = set.sse > 0.0 ? std::clamp(set.lag1 / set.sse, 0.0, kMaxNoiseLag1) : 0.0;
+  noise.rho = set.sse > 0.0 ? std::clamp(set.lag1 / set.sse, 0.0, max_lag1) : 0.0;
   noise.long_run = std::sqrt((1.0 + noise.rho) / (1.0 - noise.rho));
   return noise;
 }
@@ -359,20 +345,21 @@ DriftHarmonics fitDriftHarmonics(const std::vector<double>& theta, const std::ve
 }
 
 DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
-                             const UncertainParameters& params, int n_bins, double confidence) {
+                             const UncertainParameters& params, int n_bins, double confidence,
+                             const DriftMeasurementOptions& options) {
   if (n_bins < kMinBins || n_bins > kMaxBins)
     throw InputError("drift --measured: 4 .. 3600 theta bins");
   const PatternTrack track = trackPatternAngle(record);
-  const double covered = checkedCoverage(record, track, n_bins);
+  const double covered = checkedCoverage(record, track, n_bins, options);
   DriftComparison out;
   out.walk_rad_s = walk_rad_s;
   out.r = median(track.rs);
   out.k = median(track.ks);
   const ThetaBins bins{n_bins, (M_PI / 2) / n_bins};
   const std::vector<double> sel =
-      selectionAngle(track.th, halfWindow(covered, bins.width, track.t.size()));
-  const PassSet set = measurePasses(track, sel, bins, walk_rad_s);
-  const PooledNoise noise = poolNoise(set);
+      selectionAngle(track.th, halfWindow(covered, bins.width, track.t.size(), options));
+  const PassSet set = measurePasses(track, sel, bins, walk_rad_s, options);
+  const PooledNoise noise = poolNoise(set, options.max_noise_lag1);
   const BinMeans means = meanPerBin(set, noise, n_bins);
   const double quantile = scatterQuantile(set, noise, means, n_bins, confidence, &out);
   const ResonatorModel model = freeOscillationModelOf(params.values);

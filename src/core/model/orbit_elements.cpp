@@ -48,45 +48,6 @@ DefectAxes defectAxes(const ParameterValues& p) {
   return a;
 }
 
-OrbitRates orbitRates(const OrbitElements& e, const ParameterValues& p) {
-  const double r = e.r, k = e.k, r2 = r * r, k2 = k * k;
-  if (std::fabs(r2 - k2) <= 1e-14 * (r2 + k2) || r2 + k2 == 0.0)
-    throw InputError("orbit rates are undefined for a travelling wave (r^2 = k^2)");
-  const DefectAxes ax = defectAxes(p);
-  const double gamma = value(p, "gamma"), n = value(p, "n");
-  const double cm = value(p, "c_m"), xi = value(p, "xi"), kappa = value(p, "kappa");
-  const double sa = std::sin(4 * (e.theta - ax.alpha)), ca = std::cos(4 * (e.theta - ax.alpha));
-  const double sb = std::sin(4 * (e.theta - ax.beta)), cb = std::cos(4 * (e.theta - ax.beta));
-  OrbitRates o;
-  // (5.7), (5.8)
-  o.r_dot = 0.5 * (-gamma * r + n * k - ax.h_m * k * sa - ax.b_m * r * cb);
-  o.k_dot = 0.5 * (-gamma * k + n * r + ax.h_m * r * sa + ax.b_m * k * cb);
-  // (5.9)
-  o.theta_dot = driftRate(r, k, e.theta, p);
-  // (5.10)
-  o.chi_dot = 0.5 * cm - 3.0 * xi / 8.0 * (k2 + r2) -
-              kappa / 16.0 * (5 * k2 * k2 + 6 * k2 * r2 + 5 * r2 * r2) +
-              (r2 + k2) / (2 * (r2 - k2)) * ax.h_m * ca - r * k / (r2 - k2) * ax.b_m * sb;
-  return o;
-}
-
-double driftRate(double r, double k, double theta, const ParameterValues& p) {
-  requireFinite(r, "r");
-  requireFinite(k, "k");
-  requireFinite(theta, "theta");
-  const double r2 = r * r, k2 = k * k;
-  if (std::fabs(r2 - k2) <= 1e-14 * (r2 + k2) || r2 + k2 == 0.0)
-    throw InputError("drift rate (5.9) is undefined for r^2 = k^2 (travelling wave or no wave)");
-  const DefectAxes ax = defectAxes(p);
-  const double nu = value(p, "nu"), xi = value(p, "xi"), kappa = value(p, "kappa");
-  // xi_k (the second cubic invariant, docs/paper.md "The second cubic invariant") only turns the
-  // pattern: it adds xi_k r k / 8 here and nothing to (5.7), (5.8), (5.10).
-  const double xi_k = value(p, "xi_k");
-  return -0.25 * nu + (xi + xi_k) / 8.0 * r * k + kappa / 8.0 * r * k * (r2 + k2) -
-         r * k / (2 * (r2 - k2)) * ax.h_m * std::cos(4 * (theta - ax.alpha)) +
-         (r2 + k2) / (4 * (r2 - k2)) * ax.b_m * std::sin(4 * (theta - ax.beta));
-}
-
 std::vector<double> thetaGrid(long n) {
   if (n < 1 || n > kMaxThetaGridPoints)
     throw InputError("a theta grid needs 1.." + std::to_string(kMaxThetaGridPoints) +

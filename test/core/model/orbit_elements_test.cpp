@@ -8,6 +8,7 @@
 #include <random>
 
 #include "cvg_bench/core/model/errors.h"
+#include "model/paper_orbit_rates.h"
 
 namespace cvg_bench {
 namespace {

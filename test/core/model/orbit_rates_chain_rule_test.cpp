@@ -13,6 +13,7 @@
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/model_term.h"
 #include "cvg_bench/core/model/orbit_elements.h"
+#include "model/paper_orbit_rates.h"
 
 namespace cvg_bench {
 namespace {

@@ -15,6 +15,7 @@
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/resonator_model.h"
 #include "cvg_bench/core/simulate/full_equation_simulator.h"
+#include "model/paper_orbit_rates.h"
 
 namespace cvg_bench {
 namespace {

@@ -71,9 +71,37 @@ struct PredictedDriftHarmonics {
 PredictedDriftHarmonics predictDriftHarmonics(const UncertainParameters& params, double r,
                                               double k);
 
+/// The tuned choices of measureDrift (docs/validation_drift.md, "How the measurement works";
+/// set in 98344f3 on quartz held at k0 = 0 and 0.1, where the measured 95 % intervals covered the
+/// truth in 191/192 and 183/192 bins with these values).
+struct DriftMeasurementOptions {
+  /// Fewest samples with a pattern angle per theta bin (InputError below n_bins times this).
+  int min_samples_per_bin = 4;
+  /// Fraction of theta's period pi/2 the run must cover (the error text says "3/4"); the bins the
+  /// run misses would be gaps in theta'(theta). Set by hand (98344f3), no recorded evidence.
+  double min_covered_fraction = 0.75;
+  /// Half-window of the centred moving average of theta that assigns samples to bins, as a
+  /// fraction of the samples per bin crossing (about a quarter of a pass; selecting samples by
+  /// their own noisy theta biased every slope low: with the two other changes of 98344f3, quartz at
+  /// k0 = 0.1 went from 76/112 to 111/112 one-pass bins covered), and its bounds [samples each
+  /// side]. The fraction and bounds were set by hand.
+  double half_window_fraction = 0.125;
+  int min_half_window = 2;
+  int max_half_window = 50;
+  /// A pass counts with at least this many samples (the error text says "6 samples or more") ...
+  size_t min_pass_samples = 6;
+  /// ... crossing at least this fraction of its bin: fragments at the record's ends and
+  /// noise-driven re-entries would give slopes of a few samples. Set by hand (98344f3).
+  double min_pass_travel = 0.5;
+  /// Largest lag-1 correlation of the pooled pass noise taken into its AR(1) long-run factor
+  /// (beyond it the factor sqrt((1 + rho) / (1 - rho)) explodes on a few passes; the scatter
+  /// ratio widens the intervals instead). Set by hand (98344f3), no recorded evidence.
+  double max_noise_lag1 = 0.9;
+};
+
 /// InputError when the record is too short or theta does not cover at least 3/4 of a period.
 DriftComparison measureDrift(const SlowRecord& record, double walk_rad_s,
                              const UncertainParameters& params, int n_bins = 24,
-                             double confidence = 0.95);
+                             double confidence = 0.95, const DriftMeasurementOptions& options = {});
 
 }  // namespace cvg_bench

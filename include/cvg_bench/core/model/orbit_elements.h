@@ -1,7 +1,9 @@
 // Orbit elements of section 5: r (main wave amplitude), k (quadrature amplitude), theta (wave
-// pattern angle) and chi (temporal phase), by the change of variables (5.2), and their averaged
-// evolution (5.7)-(5.10) with the corrections of docs/paper.md item 4-5: the nonlinear terms carry
-// the tilde coefficients, and the damping-anisotropy terms depend on (theta - beta).
+// pattern angle) and chi (temporal phase), by the change of variables (5.2). Their averaged
+// evolution (5.7)-(5.10) of any model comes from the model's own equations
+// (orbit_rates_chain_rule.h); the paper's printed closed form, with the corrections of
+// docs/paper.md items 4-5, is the tests' known answer (test/core/model/paper_orbit_rates.h), so no
+// term's name is spelled here.
 #pragma once
 
 #include <Eigen/Core>
@@ -36,18 +38,10 @@ struct DefectAxes {
 };
 DefectAxes defectAxes(const ParameterValues& p);
 
+/// Rates of the orbit elements [1/s, 1/s, rad/s, rad/s] (orbit_rates_chain_rule.h).
 struct OrbitRates {
   double r_dot = 0.0, k_dot = 0.0, theta_dot = 0.0, chi_dot = 0.0;
 };
-
-/// (5.7)-(5.10) (corrected) for free oscillation (u = 0) with the paper's terms gamma, nu, b_c,
-/// b_s, c_m, n, h_c, h_s, xi, kappa and the second cubic invariant xi_k (theta' only) taken from p
-/// (missing ones are 0). Requires r^2 != k^2.
-OrbitRates orbitRates(const OrbitElements& e, const ParameterValues& p);
-
-/// The drift rate theta' of (5.9) [rad/s] (corrected; plus xi_k r k / 8), the gyro's zero-rate
-/// error at (r, k, theta).
-double driftRate(double r, double k, double theta, const ParameterValues& p);
 
 /// Most points a pattern-angle grid may have.
 constexpr long kMaxThetaGridPoints = 100000;

@@ -1,7 +1,7 @@
 // Orbit-element rates of any model by the chain rule (issue #26): the drift prediction comes from
 // the model's own averaged equations, so a registered term contributes without anyone editing a
-// drift formula. The printed (5.7)-(5.10) (orbit_elements.h orbitRates) are its known answer for
-// the paper's terms.
+// drift formula. The printed (5.7)-(5.10) (test/core/model/paper_orbit_rates.h) are its known
+// answer for the paper's terms.
 #pragma once
 
 #include "cvg_bench/core/model/orbit_elements.h"
