@@ -80,6 +80,29 @@ nlohmann::json estimateWithCi(const ParameterEstimate& p, double scale = 1.0) {
 
 }  // namespace
 
+nlohmann::json quadratureGrowthToJson(const QuadratureGrowth& g) {
+  if (!g.valid) return {{"valid", false}, {"why_not", g.why_not}};
+  nlohmann::json shares = nlohmann::json::array();
+  for (const QuadratureShare& s : g.shares)
+    shares.push_back({{"parameters", s.parameters},
+                      {"meaning", s.meaning},
+                      {"widening_per_s", estimateWithCi(s.widening)},
+                      {"determined", s.determined}});
+  return {{"valid", true},
+          {"what",
+           "d|k|/dt of the selected model at the record's median state, split into the shares of "
+           "its parameter groups (what the rate loses when the group is set to 0); groups the "
+           "covariance cannot tell apart are one share; measured = the record's k' with k's sign"},
+          {"r", g.r},
+          {"k", g.k},
+          {"theta_rad", g.theta_rad},
+          {"measured_widening_per_s", estimateWithCi(g.measured_widening)},
+          {"predicted_widening_per_s", estimateWithCi(g.predicted_widening)},
+          {"shares", shares},
+          {"named", g.named},
+          {"summary", g.summary}};
+}
+
 nlohmann::json orbitReadingToJson(const OrbitReading& m) {
   constexpr double kDegH = 180.0 / M_PI * 3600.0;
   nlohmann::json j;
@@ -108,9 +131,12 @@ nlohmann::json orbitReadingToJson(const OrbitReading& m) {
     o["Q"] = x.q.value > 0.0 ? estimateWithCi(x.q) : nlohmann::json(nullptr);
     o["predicted_theta_rate_deg_h"] =
         x.has_prediction ? estimateWithCi(x.predicted_theta_rate, kDegH) : nlohmann::json(nullptr);
+    o["predicted_k_rate_per_s"] =
+        x.has_prediction ? estimateWithCi(x.predicted_k_rate) : nlohmann::json(nullptr);
     w.push_back(o);
   }
   j["windows"] = w;
+  j["quadrature_growth"] = quadratureGrowthToJson(m.quadrature_growth);
   j["summary"] = m.summary;
   return j;
 }

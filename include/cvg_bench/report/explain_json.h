@@ -13,6 +13,8 @@ namespace report {
 
 nlohmann::json explanationToJson(const Explanation& x);
 /// "measured" of explain's JSON (free decay): the model-free orbit reading (orbit_reading.h).
+/// quadrature_growth.h as JSON (orbitReadingToJson's "quadrature_growth").
+nlohmann::json quadratureGrowthToJson(const QuadratureGrowth& g);
 nlohmann::json orbitReadingToJson(const OrbitReading& m);
 
 }  // namespace report

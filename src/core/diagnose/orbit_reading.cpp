@@ -8,6 +8,7 @@
 #include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/orbit_elements.h"
+#include "cvg_bench/core/model/orbit_rates_chain_rule.h"
 #include "cvg_bench/core/model/sample_median.h"
 
 namespace cvg_bench {
@@ -84,9 +85,11 @@ OrbitReading readOrbit(const SlowRecord& record, double omega_rad_s, const Estim
   out.period_s = omega > 0.0 ? 2.0 * M_PI / omega : 0.0;
   out.n_samples = static_cast<int>(t.size());
   UncertainParameters up;
+  ResonatorModel model("linear", ExperimentMode::kFreeDecay);
   if (final_estimate != nullptr) {
     up = uncertainParameters(*final_estimate);
     out.model = final_estimate->model;
+    model = freeOscillationModelOf(up.values);
   }
   const double span = t.back() - t.front();
   std::vector<double> theta_rates, k_rates;
@@ -122,6 +125,9 @@ OrbitReading readOrbit(const SlowRecord& record, double omega_rad_s, const Estim
     if (final_estimate != nullptr && std::abs(win.k) < win.r) {
       try {
         win.predicted_theta_rate = driftRateWithInterval(win.r, win.k, win.theta_rad, up);
+        const OrbitElements state{win.r, win.k, win.theta_rad, 0.0};
+        win.predicted_k_rate = deltaMethod(
+            [&](const ParameterValues& v) { return orbitRatesOfModel(model, v, state).k_dot; }, up);
         win.has_prediction = true;
       } catch (const std::exception&) {
       }
@@ -132,6 +138,11 @@ OrbitReading readOrbit(const SlowRecord& record, double omega_rad_s, const Estim
   }
   out.theta_rate = meanOfWindows(theta_rates, confidence);
   out.k_rate = meanOfWindows(k_rates, confidence);
+  if (final_estimate != nullptr) {
+    const double r_med = median(r), k_med = median(k),
+                 th_med = std::remainder(median(th), M_PI / 2);
+    out.quadrature_growth = explainQuadratureGrowth(up, r_med, k_med, th_med, out.k_rate);
+  }
   std::ostringstream s;
   s.precision(4);
   s << "measured, before any model (orbit elements (5.2) of " << out.n_samples
@@ -148,9 +159,12 @@ OrbitReading readOrbit(const SlowRecord& record, double omega_rad_s, const Estim
         << " at r " << b.r;
     if (a.has_prediction && b.has_prediction)
       s << "; " << out.model << " predicts theta' " << degH(a.predicted_theta_rate) << " and "
-        << degH(b.predicted_theta_rate) << " there";
+        << degH(b.predicted_theta_rate) << " there; k' " << a.k_rate.value << " and "
+        << b.k_rate.value << " measured, " << a.predicted_k_rate.value << " and "
+        << b.predicted_k_rate.value << " predicted";
   }
   if (out.period_s > 0) s << "; period " << out.period_s << " s";
+  if (out.quadrature_growth.valid) s << ". Ellipse: " << out.quadrature_growth.summary;
   out.summary = s.str();
   return out;
 }

@@ -19,6 +19,15 @@ class LinearDefectTerm : public ModelTerm {
     return "linear defects: damping, rotation term, damping anisotropy, position forces, "
            "frequency split (2.3)";
   }
+  std::string parameterMeaning(const std::string& parameter) const override {
+    if (parameter == "gamma") return "damping";
+    if (parameter == "nu") return "rotation term";
+    if (parameter == "b_c" || parameter == "b_s") return "damping anisotropy";
+    if (parameter == "c_m") return "mean frequency offset";
+    if (parameter == "n") return "position (circulatory) forces";
+    if (parameter == "h_c" || parameter == "h_s") return "frequency split";
+    return description();
+  }
   void averagedColumns(const Eigen::Vector4d& q, const SlowContext&,
                        Eigen::Ref<Eigen::MatrixXd> d) const override {
     const double q1 = q[0], p1 = q[1], q2 = q[2], p2 = q[3];

@@ -5,6 +5,12 @@
 
 namespace cvg_bench {
 
+std::string ModelTerm::parameterMeaning(const std::string& parameter) const {
+  for (const CandidateExtension& c : candidates())
+    if (c.parameter == parameter) return c.cause;
+  return description();
+}
+
 void ModelTerm::averagedJacobian(const Eigen::Vector4d& q, const SlowContext& ctx,
                                  const Eigen::Ref<const Eigen::VectorXd>& z_term,
                                  Eigen::Matrix4d& jacobian) const {

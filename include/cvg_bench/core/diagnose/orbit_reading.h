@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cvg_bench/core/diagnose/quadrature_growth.h"
 #include "cvg_bench/core/estimate/estimate.h"
 #include "cvg_bench/core/io/records.h"
 
@@ -25,6 +26,7 @@ struct OrbitWindow {
   ParameterEstimate q;                       ///< omega / (-2 r'/r); value 0 when r does not fall
   bool has_prediction = false;
   ParameterEstimate predicted_theta_rate;  ///< the model's theta' at (r, k, theta) [rad/s]
+  ParameterEstimate predicted_k_rate;      ///< the model's k' there [amplitude/s]
 };
 
 struct OrbitReading {
@@ -36,7 +38,10 @@ struct OrbitReading {
   ParameterEstimate theta_rate;  ///< over the record (mean of the windows) [rad/s]
   ParameterEstimate k_rate;      ///< over the record [amplitude/s]
   std::string model;             ///< the model of the predictions ("" without one)
-  std::string summary;           ///< one paragraph for the text report
+  /// With a model: what makes the ellipse's width change, at the record's median state against
+  /// the measured k_rate (quadrature_growth.h); invalid without a model or its covariance.
+  QuadratureGrowth quadrature_growth;
+  std::string summary;  ///< one paragraph for the text report
 };
 
 /// Reads the orbit of a free-decay slow record (omega from the record or `omega_rad_s`); with a

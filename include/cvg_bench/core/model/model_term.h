@@ -84,6 +84,10 @@ class ModelTerm {
   virtual std::vector<std::string> parameterNames() const = 0;
   /// One sentence: what the term is physically.
   virtual std::string description() const = 0;
+  /// What one of its parameters is physically, a short noun phrase ("frequency split"); parameters
+  /// of one term with the same meaning act together (a modulus and its axis: h_c, h_s). The
+  /// default is the cause of the candidate that adds the parameter, else description().
+  virtual std::string parameterMeaning(const std::string& parameter) const;
   /// Whether the term exists in the given experiment mode (e.g. controls only when forced).
   virtual bool appliesTo(ExperimentMode mode) const { return true; }
   /// The extensions of the linear base this term offers to `explain` (none by default).

@@ -25,16 +25,9 @@ UncertainParameters uncertainParameters(const Estimate& e) {
   return p;
 }
 
-ParameterEstimate deltaMethod(const std::function<double(const ParameterValues&)>& f,
-                              const UncertainParameters& p) {
-  ParameterEstimate out;
-  out.value = f(p.values);
-  requireFinite(out.value, "derived value");
+Eigen::VectorXd deltaMethodGradient(const std::function<double(const ParameterValues&)>& f,
+                                    const UncertainParameters& p) {
   const int n = static_cast<int>(p.cov_names.size());
-  if (n == 0) {
-    out.ci_low = out.ci_high = out.value;
-    return out;
-  }
   if (p.covariance.rows() != n || p.covariance.cols() != n)
     throw InputError("covariance is not " + std::to_string(n) + " x " + std::to_string(n));
   Eigen::VectorXd grad(n);
@@ -49,6 +42,19 @@ ParameterEstimate deltaMethod(const std::function<double(const ParameterValues&)
     minus[p.cov_names[j]] = v - h;
     grad[j] = (f(plus) - f(minus)) / (2.0 * h);
   }
+  return grad;
+}
+
+ParameterEstimate deltaMethod(const std::function<double(const ParameterValues&)>& f,
+                              const UncertainParameters& p) {
+  ParameterEstimate out;
+  out.value = f(p.values);
+  requireFinite(out.value, "derived value");
+  if (p.cov_names.empty()) {
+    out.ci_low = out.ci_high = out.value;
+    return out;
+  }
+  const Eigen::VectorXd grad = deltaMethodGradient(f, p);
   return interval(out.value, grad.dot(p.covariance * grad), studentQuantile(p.confidence, p.dof));
 }
 

@@ -28,6 +28,11 @@ struct UncertainParameters {
 /// From an Estimate (values, names, covariance = the honest one, interval_dof, confidence).
 UncertainParameters uncertainParameters(const Estimate& e);
 
+/// The gradient of f over the covariance's parameters (cov_names order) by central differences
+/// at a small fraction of each standard error; InputError when the covariance's size is wrong.
+Eigen::VectorXd deltaMethodGradient(const std::function<double(const ParameterValues&)>& f,
+                                    const UncertainParameters& p);
+
 /// Delta-method interval of any scalar function of the named values.
 ParameterEstimate deltaMethod(const std::function<double(const ParameterValues&)>& f,
                               const UncertainParameters& p);
