@@ -16,92 +16,6 @@
 namespace cvg_bench {
 namespace {
 
-/// A floor: the fitted floor lies this far above the decay's straight continuation at the end
-/// [dB], and the floor model beats the straight line by this evidence (n ln(SSE_0 / SSE_1)).
-constexpr double kFloorExcessDb = 3.0;
-constexpr double kFloorEvidence = 30.0;
-/// A noise floor scatters: ln of the Rayleigh amplitude of noise alone has sd pi / sqrt(24) = 0.64;
-/// past the line's crossing of the floor the scatter of ln A about a straight line must exceed
-/// this [neper] (1.7 dB), else the bend is a slowing decay (a damping law in A, the slower mode of
-/// two, a detection change), not a floor.
-constexpr double kFloorScatter = 0.2;
-/// Without the evidence, a floor also confirms when that scatter is this many times the one over
-/// the first half of the decay before the crossing (the signal's own noise).
-constexpr double kFloorScatterRatio = 2.0;
-/// A ring-down needs this many samples: in the envelope, on the peak's grid, in the span (step 4).
-constexpr size_t kMinSamples = 8;
-/// Step 1: drop-outs are read against a running median of this half-width (window 11).
-constexpr int kDropoutMedianHalf = 5;
-/// Step 1: the noise scale is read over the record's first half, at least this many samples.
-constexpr size_t kMinScaleSamples = 8;
-/// Step 1: a drop-out lies this many robust sd below the running median (or dropout_depth_db) ...
-constexpr double kDropoutDepthSd = 8.0;
-/// ... and this many local robust sd (MAD about the running median over 2 kLocalMadHalf + 1
-/// samples).
-constexpr double kDropoutLocalSd = 6.0;
-constexpr size_t kLocalMadHalf = 10;
-/// The smoothed envelope: a running median of half-width a kSmoothDivisor-th of the window, at
-/// least kMinSmoothHalf samples.
-constexpr size_t kSmoothDivisor = 100;
-constexpr int kMinSmoothHalf = 2;
-/// The peak is read on a grid of at most this many samples.
-constexpr size_t kPeakGridPoints = 1500;
-/// Step 2: the tail level is the median over the window's last kTailDivisor-th, at least
-/// kMinTailSamples samples.
-constexpr size_t kTailDivisor = 10;
-constexpr size_t kMinTailSamples = 4;
-/// Step 2: the floor fit starts kStretchTopDb (or kStretchTopFraction of the drop) above the tail
-/// level [dB] ...
-constexpr double kStretchTopDb = 25.0;
-constexpr double kStretchTopFraction = 0.75;
-/// ... when the decay goes on to kStretchBottomDb (or kStretchBottomFraction of the drop) above it
-/// [dB] over more than kMinStretchSamples samples.
-constexpr double kStretchBottomDb = 10.0;
-constexpr double kStretchBottomFraction = 0.25;
-constexpr size_t kMinStretchSamples = 4;
-/// Step 2: the envelope reaches a confirmed floor within this of it [dB] (floor_start_s).
-constexpr double kFloorReachDb = 3.0;
-/// Step 3: the plateau level is the median over the window's first kHeadDivisor-th, at least
-/// kMinHeadSamples samples.
-constexpr size_t kHeadDivisor = 20;
-constexpr size_t kMinHeadSamples = 5;
-/// Step 3: the switch-off threshold lies max(kSwitchOffSd robust sd, kSwitchOffMinDb [dB]) below
-/// the plateau; for a plateau that creeps, kWideSwitchOffDb [dB].
-constexpr double kSwitchOffSd = 6.0;
-constexpr double kSwitchOffMinDb = 0.1;
-constexpr double kWideSwitchOffDb = 1.0;
-/// Step 3: the crossing is read below this quantile of the head (h.size() / 20: the 5th
-/// percentile).
-constexpr size_t kPercentileDivisor = 20;
-/// Step 3: the rate after the crossing over a kAfterDivisor-th of the window, at least
-/// kMinAfterSamples samples.
-constexpr size_t kAfterDivisor = 20;
-constexpr size_t kMinAfterSamples = 8;
-/// Step 3: falling steadily: differences over a kLagDivisor-th of the stretch before the crossing,
-/// kFallingShare of them negative, and a mean rate of kPlateauRateRatio of the one after or more.
-constexpr size_t kLagDivisor = 10;
-constexpr double kFallingShare = 0.9;
-constexpr double kPlateauRateRatio = 0.3;
-/// Step 3: a plateau's crossing lies past this sample, and later than kPlateauDelay times the time
-/// the decay takes to fall by the threshold.
-constexpr size_t kMinCrossIndex = 2;
-constexpr double kPlateauDelay = 3.0;
-/// Detector settling is read on spans of more than this many samples ...
-constexpr size_t kMinSettlingSpan = 40;
-/// ... within the first kSettlingSkipDb of decay [dB] (at most that is skipped), against the rate
-/// from there to kSettlingRateEndDb [dB] over more than kMinSettlingRateSamples samples ...
-constexpr double kSettlingSkipDb = 3.0;
-constexpr double kSettlingRateEndDb = 13.0;
-constexpr size_t kMinSettlingRateSamples = 8;
-/// ... with the local rate over a kRateWindowDivisor-th of the window, at least kMinRateWindow
-/// samples ...
-constexpr size_t kRateWindowDivisor = 80;
-constexpr size_t kMinRateWindow = 8;
-/// ... and the span starts this many times the time to the rate's peak after the drive-off.
-constexpr double kSettlingTimeFactor = 2.0;
-/// Step 4: a decay spans min_decay_db and this many robust sd of ln A or more.
-constexpr double kMinDecaySd = 10.0;
-
 double median(const std::vector<double>& v) {
   return sampleMedian(v);
 }
@@ -230,6 +144,14 @@ std::vector<std::string> RingdownSegmentationOptions::validate() const {
   if (!(short_decay_db > 0.0)) p.push_back("short_decay_db must be > 0 dB");
   if (!(dropout_depth_db > 0.0)) p.push_back("dropout_depth_db must be > 0 dB");
   if (!(min_decay_db > 0.0)) p.push_back("min_decay_db must be > 0 dB");
+  // The divisors split a window's sample count (a zero would divide by zero).
+  for (const size_t d : {min_samples, smoothing.divisor, smoothing.peak_grid_points,
+                         noise_floor.tail_divisor, plateau.head_divisor, plateau.percentile_divisor,
+                         plateau.after_divisor, plateau.lag_divisor, settling.rate_window_divisor})
+    if (d < 1) {
+      p.push_back("min_samples and the segmentation's divisors must be >= 1");
+      break;
+    }
   return p;
 }
 
@@ -249,7 +171,7 @@ std::vector<double> runningMedian(const std::vector<double>& y, const std::vecto
 
 namespace {
 
-/// The smoothed envelope's peak, read on a grid of at most kPeakGridPoints samples.
+/// The smoothed envelope's peak, read on a grid of at most peak_grid_points samples.
 struct EnvelopePeak {
   double level = -std::numeric_limits<double>::infinity();  ///< ln A
   size_t i = 0;
@@ -259,40 +181,43 @@ struct EnvelopePeak {
 /// seg's dropout and noise_sd_log.
 void markDropouts(const std::vector<double>& y, size_t n,
                   const RingdownSegmentationOptions& options, RingdownSegment* seg) {
+  const RingdownSegmentationOptions::Dropouts& o = options.dropouts;
   std::vector<bool>& dropout = seg->dropout;
-  const std::vector<double> med = runningMedian(y, dropout, kDropoutMedianHalf);
+  const std::vector<double> med = runningMedian(y, dropout, o.median_half);
   std::vector<double> d;
   // Scale from the first half (plateau and early decay): the floor's log noise is far larger.
-  for (size_t i = 1; i < std::max<size_t>(n / 2, kMinScaleSamples); ++i)
+  for (size_t i = 1; i < std::max<size_t>(n / 2, o.min_scale_samples); ++i)
     if (!dropout[i] && !dropout[i - 1]) d.push_back(std::fabs(y[i] - y[i - 1]));
   seg->noise_sd_log = d.empty() ? 0.0 : kGaussianSdPerMad * median(d) / std::sqrt(2.0);
   // Depth: 3 dB, or 6 local robust sd (MAD about the running median over 21 samples), so that
   // the Rice dips of additive noise near the floor are not taken for drop-outs.
   const double depth0 =
-      std::max(kDropoutDepthSd * seg->noise_sd_log, options.dropout_depth_db / kDbPerNeper);
+      std::max(o.depth_sd * seg->noise_sd_log, options.dropout_depth_db / kDbPerNeper);
   std::vector<double> dev(n, 0.0);
   for (size_t i = 0; i < n; ++i)
     dev[i] = std::isfinite(med[i]) && !dropout[i] ? std::fabs(y[i] - med[i]) : 0.0;
   for (size_t i = 0; i < n; ++i) {
     if (dropout[i] || !std::isfinite(med[i])) continue;
     std::vector<double> w;
-    for (size_t j = i >= kLocalMadHalf ? i - kLocalMadHalf : 0;
-         j <= std::min(n - 1, i + kLocalMadHalf); ++j)
+    for (size_t j = i >= o.local_mad_half ? i - o.local_mad_half : 0;
+         j <= std::min(n - 1, i + o.local_mad_half); ++j)
       if (!dropout[j]) w.push_back(dev[j]);
     const double local = kGaussianSdPerMad * median(w);
-    if (y[i] < med[i] - std::max(depth0, kDropoutLocalSd * local)) dropout[i] = true;
+    if (y[i] < med[i] - std::max(depth0, o.local_sd * local)) dropout[i] = true;
   }
 }
 
-/// The peak of the smoothed envelope sm; throws AnalysisError under kMinSamples usable samples.
-EnvelopePeak smoothedPeak(const std::vector<double>& sm, size_t n) {
+/// The peak of the smoothed envelope sm; throws AnalysisError under min_samples usable samples.
+EnvelopePeak smoothedPeak(const std::vector<double>& sm, size_t n,
+                          const RingdownSegmentationOptions& options) {
   // A subsampled grid of the smoothed envelope (<= 1500 points) for the peak below.
-  const size_t stride = std::max<size_t>(1, n / kPeakGridPoints);
+  const size_t stride = std::max<size_t>(1, n / options.smoothing.peak_grid_points);
   std::vector<size_t> idx;
   for (size_t i = 0; i < n; i += stride)
     if (std::isfinite(sm[i])) idx.push_back(i);
-  if (idx.size() < kMinSamples)
-    throw AnalysisError("ring-down: fewer than 8 usable envelope samples");
+  if (idx.size() < options.min_samples)
+    throw AnalysisError("ring-down: fewer than " + std::to_string(options.min_samples) +
+                        " usable envelope samples");
   double peak_sm = -std::numeric_limits<double>::infinity();
   size_t i_peak = 0;
   for (size_t i : idx)
@@ -311,17 +236,19 @@ struct LastStretch {
   size_t a = 0, b = 0;
 };
 
-LastStretch lastStretch(const std::vector<double>& sm, size_t n, const EnvelopePeak& peak) {
-  const size_t tail_a = n - std::max<size_t>(kMinTailSamples, n / kTailDivisor);
+LastStretch lastStretch(const std::vector<double>& sm, size_t n, const EnvelopePeak& peak,
+                        const RingdownSegmentationOptions::NoiseFloor& o) {
+  const size_t tail_a = n - std::max<size_t>(o.min_tail_samples, n / o.tail_divisor);
   std::vector<double> tail;
   for (size_t i = tail_a; i < n; ++i)
     if (std::isfinite(sm[i])) tail.push_back(sm[i]);
   const double tail_level = tail.empty() ? peak.level : median(tail);
   const double total = peak.level - tail_level;
   // The decay's last stretch: from 25 dB (or 3/4 of the drop) to 10 dB (or 1/4) above the tail.
-  const double hi = tail_level + std::min(kStretchTopDb / kDbPerNeper, kStretchTopFraction * total);
+  const double hi =
+      tail_level + std::min(o.stretch_top_db / kDbPerNeper, o.stretch_top_fraction * total);
   const double lo =
-      tail_level + std::min(kStretchBottomDb / kDbPerNeper, kStretchBottomFraction * total);
+      tail_level + std::min(o.stretch_bottom_db / kDbPerNeper, o.stretch_bottom_fraction * total);
   size_t a = n, b = n;
   for (size_t i = peak.i; i < n; ++i) {
     if (!std::isfinite(sm[i])) continue;
@@ -356,16 +283,17 @@ FloorCut readFloor(const RingdownEnvelope& env, const std::vector<double>& sm, s
   const size_t i_peak = peak.i;
   size_t i_end = n;
   double margin_db = options.floor_margin_db;
-  const LastStretch ls = lastStretch(sm, n, peak);
+  const RingdownSegmentationOptions::NoiseFloor& o = options.noise_floor;
+  const LastStretch ls = lastStretch(sm, n, peak, o);
   const size_t a = ls.a, b = ls.b;
   if (ls.total > (options.floor_margin_db + options.min_decay_db) / kDbPerNeper && a < n && b < n &&
-      b > a + kMinStretchSamples) {
+      b > a + o.min_stretch_samples) {
     const FloorFit ff = fitFloor(t, y, seg->dropout, a, ls.tail_level);
     const double excess = ff.floor_log - ff.line_end;
-    const bool scatters = ff.tail_sd > kFloorScatter;  // false when NaN
-    const bool confirmed =
-        ff.ok && ff.slope < 0.0 && excess > kFloorExcessDb / kDbPerNeper && scatters &&
-        (ff.evidence > kFloorEvidence || ff.tail_sd > kFloorScatterRatio * ff.head_sd);
+    const bool scatters = ff.tail_sd > o.scatter;  // false when NaN
+    const bool confirmed = ff.ok && ff.slope < 0.0 && excess > o.excess_db / kDbPerNeper &&
+                           scatters &&
+                           (ff.evidence > o.evidence || ff.tail_sd > o.scatter_ratio * ff.head_sd);
     // A decay that rises less than margin + short_decay_db above its floor keeps
     // short_decay_db of decay: the margin shrinks to what is left, down to min_floor_margin_db
     // (the fit holds the floor; D008 of the development set: 16 dB above a floor, 3 dB left).
@@ -397,7 +325,7 @@ FloorCut readFloor(const RingdownEnvelope& env, const std::vector<double>& sm, s
           i_end = i;
           break;
         }
-      const double reach = floor_log + kFloorReachDb / kDbPerNeper;
+      const double reach = floor_log + o.reach_db / kDbPerNeper;
       seg->floor_start_s = t.back();
       for (size_t i = i_end; i < n; ++i)
         if (std::isfinite(sm[i]) && sm[i] <= reach) {
@@ -420,6 +348,7 @@ struct SwitchOffInput {
   const std::vector<bool>& dropout;
   size_t n, n_head, i_end;
   double c0;
+  const RingdownSegmentationOptions::Plateau& o;
 };
 
 /// The switch-off read with a threshold delta below the plateau: the crossing, the decay rate
@@ -439,7 +368,7 @@ size_t crossingBelow(const SwitchOffInput& in, double delta, size_t upto, double
   for (size_t i = 0; i < upto; ++i)
     if (std::isfinite(sm[i])) h.push_back(sm[i]);
   std::sort(h.begin(), h.end());
-  *level = h.empty() ? in.c0 : h[h.size() / kPercentileDivisor];
+  *level = h.empty() ? in.c0 : h[h.size() / in.o.percentile_divisor];
   for (size_t i = 0; i < in.i_end; ++i)
     if (std::isfinite(sm[i]) && sm[i] < *level - delta) return i;
   return size_t{0};
@@ -475,18 +404,18 @@ size_t switchOffCrossing(const SwitchOffInput& in, double delta) {
 bool fallsSteadily(const SwitchOffInput& in, size_t i_cross, double s_after) {
   const std::vector<double>& sm = in.sm;
   const double s_before = -slopeOver(in.t, sm, in.dropout, 0, i_cross);
-  const size_t lag = std::max<size_t>(1, i_cross / kLagDivisor);
+  const size_t lag = std::max<size_t>(1, i_cross / in.o.lag_divisor);
   size_t down = 0, all = 0;
   for (size_t i = 0; i + lag < i_cross; ++i)
     if (std::isfinite(sm[i]) && std::isfinite(sm[i + lag])) ++all, down += sm[i + lag] < sm[i];
-  return all > 0 && down >= kFallingShare * all && s_before >= kPlateauRateRatio * s_after;
+  return all > 0 && down >= in.o.falling_share * all && s_before >= in.o.rate_ratio * s_after;
 }
 
 SwitchOff readSwitchOff(const SwitchOffInput& in, double delta) {
   const std::vector<double>& t = in.t;
   const size_t i_cross = switchOffCrossing(in, delta);
-  const size_t m_after =
-      std::min(in.i_end, i_cross + std::max<size_t>(kMinAfterSamples, in.n / kAfterDivisor));
+  const size_t m_after = std::min(
+      in.i_end, i_cross + std::max<size_t>(in.o.min_after_samples, in.n / in.o.after_divisor));
   const double s_after = -slopeOver(t, in.sm, in.dropout, i_cross, m_after);
   // A plateau does not fall steadily at 0.3 or more of the rate after the crossing (a record that
   // starts inside a fast first stage of the decay has no plateau; its median level over the first
@@ -494,8 +423,8 @@ SwitchOff readSwitchOff(const SwitchOffInput& in, double delta) {
   const bool falling = fallsSteadily(in, i_cross, s_after);
   SwitchOff r;
   r.delta = delta, r.i_cross = i_cross, r.s_after = s_after, r.falling = falling;
-  r.has_plateau = s_after > 0.0 && i_cross > kMinCrossIndex &&
-                  t[i_cross] - t.front() > kPlateauDelay * delta / s_after && !falling;
+  r.has_plateau = s_after > 0.0 && i_cross > in.o.min_cross_index &&
+                  t[i_cross] - t.front() > in.o.delay * delta / s_after && !falling;
   return r;
 }
 
@@ -508,28 +437,28 @@ SwitchOff readSwitchOff(const SwitchOffInput& in, double delta) {
 /// first 3 dB of decay are skipped. Returns the span's start.
 size_t settledStart(const std::vector<double>& t, const std::vector<double>& sm,
                     const std::vector<bool>& dropout, size_t n, size_t i_start, size_t i_end,
-                    double drive_off_s) {
-  if (!(i_end > i_start + kMinSettlingSpan)) return i_start;
+                    double drive_off_s, const RingdownSegmentationOptions::Settling& o) {
+  if (!(i_end > i_start + o.min_span)) return i_start;
   const double s0 = sm[i_start];
   size_t a3 = i_end, a13 = i_end;
   for (size_t i = i_start; i < i_end; ++i) {
     if (!std::isfinite(sm[i])) continue;
-    if (a3 == i_end && sm[i] <= s0 - kSettlingSkipDb / kDbPerNeper) a3 = i;
-    if (sm[i] <= s0 - kSettlingRateEndDb / kDbPerNeper) {
+    if (a3 == i_end && sm[i] <= s0 - o.skip_db / kDbPerNeper) a3 = i;
+    if (sm[i] <= s0 - o.rate_end_db / kDbPerNeper) {
       a13 = i;
       break;
     }
   }
-  if (!(a3 < i_end && a13 > a3 + kMinSettlingRateSamples)) return i_start;
+  if (!(a3 < i_end && a13 > a3 + o.min_rate_samples)) return i_start;
   // Time of the peak local rate within the first 3 dB (window centre).
-  const size_t w = std::max<size_t>(kMinRateWindow, n / kRateWindowDivisor);
+  const size_t w = std::max<size_t>(o.min_rate_window, n / o.rate_window_divisor);
   double peak = slopeOver(t, sm, dropout, a3, a13);  // negative: ln A falls
   double t_peak = drive_off_s;
   for (size_t i = i_start; i + w < a3; ++i) {
     const double sl = slopeOver(t, sm, dropout, i, i + w);
     if (sl < peak) peak = sl, t_peak = 0.5 * (t[i] + t[i + w - 1]);
   }
-  const double t_skip = drive_off_s + kSettlingTimeFactor * std::max(0.0, t_peak - drive_off_s);
+  const double t_skip = drive_off_s + o.time_factor * std::max(0.0, t_peak - drive_off_s);
   size_t i_new = i_start;
   while (i_new < a3 && t[i_new] < t_skip) ++i_new;
   return i_new;
@@ -596,8 +525,9 @@ RingdownSegment segmentWindow(const RingdownEnvelope& env,
   const auto problems = options.validate();
   if (!problems.empty()) throw InputError("ring-down segmentation: " + problems.front());
   const size_t n = env.size();
-  if (n < kMinSamples)
-    throw InputError("ring-down envelope has " + std::to_string(n) + " samples (< 8)");
+  if (n < options.min_samples)
+    throw InputError("ring-down envelope has " + std::to_string(n) + " samples (< " +
+                     std::to_string(options.min_samples) + ")");
   const auto& t = env.t_s;
   const auto& y = env.log_amplitude;
   RingdownSegment seg;
@@ -606,9 +536,10 @@ RingdownSegment segmentWindow(const RingdownEnvelope& env,
 
   // 1. Drop-outs against the running median (window 11), robust scale from differences.
   markDropouts(y, n, options, &seg);
-  const int half = std::max(kMinSmoothHalf, static_cast<int>(n / kSmoothDivisor));
+  const int half =
+      std::max(options.smoothing.min_half, static_cast<int>(n / options.smoothing.divisor));
   const std::vector<double> sm = runningMedian(y, seg.dropout, half);
-  const EnvelopePeak peak = smoothedPeak(sm, n);
+  const EnvelopePeak peak = smoothedPeak(sm, n, options);
 
   // 2. Noise floor: from 25 dB above the level of the record's last tenth to the end, a straight
   // decay plus an additive floor beats the straight decay, with the floor above its continuation.
@@ -620,20 +551,22 @@ RingdownSegment segmentWindow(const RingdownEnvelope& env,
   // twentieth (a running median keeps the corner sharp); the decay starts where the envelope first
   // falls delta = max(6 sd, 0.1 dB) below it. A plateau exists when that crossing comes later than
   // three times the time the decay takes to fall by delta.
-  const size_t n_head = std::min(n, std::max<size_t>(kMinHeadSamples, n / kHeadDivisor));
+  const size_t n_head = std::min(
+      n, std::max<size_t>(options.plateau.min_head_samples, n / options.plateau.head_divisor));
   std::vector<double> head;
   for (size_t i = 0; i < n_head; ++i)
     if (std::isfinite(sm[i])) head.push_back(sm[i]);
   const double c0 = median(head);
-  const double delta_noise =
-      std::max(kSwitchOffSd * seg.noise_sd_log, kSwitchOffMinDb / kDbPerNeper);
-  const SwitchOffInput in{t, sm, seg.dropout, n, n_head, i_end, c0};
+  const double delta_noise = std::max(options.plateau.switch_off_sd * seg.noise_sd_log,
+                                      options.plateau.switch_off_min_db / kDbPerNeper);
+  const SwitchOffInput in{t, sm, seg.dropout, n, n_head, i_end, c0, options.plateau};
   // A drive level that creeps by a few tenths of a dB (an oscillator's amplitude loop on a real
   // export, D060 of the development set: 0.6 dB over 1.6 s) crosses a noise-sized threshold on the
   // plateau, where nothing decays after it: then the switch-off is read 1 dB below the plateau.
   SwitchOff so = readSwitchOff(in, delta_noise);
   if (!so.has_plateau && !so.falling) {
-    const SwitchOff wide = readSwitchOff(in, std::max(delta_noise, kWideSwitchOffDb / kDbPerNeper));
+    const SwitchOff wide =
+        readSwitchOff(in, std::max(delta_noise, options.plateau.wide_switch_off_db / kDbPerNeper));
     if (wide.has_plateau) so = wide;
   }
   const double delta = so.delta;
@@ -645,17 +578,17 @@ RingdownSegment segmentWindow(const RingdownEnvelope& env,
   const double best_c = c0;
   size_t i_start = seg.has_plateau ? i_cross : 0;
   // Detector settling: the first decibels, while the detector's filter catches up, are skipped.
-  i_start = settledStart(t, sm, seg.dropout, n, i_start, i_end, seg.drive_off_s);
+  i_start = settledStart(t, sm, seg.dropout, n, i_start, i_end, seg.drive_off_s, options.settling);
 
   // 4. Refusal: too short a span, too little decay.
   seg.floor_margin_db = margin_db;
-  if (i_end <= i_start + kMinSamples)
+  if (i_end <= i_start + options.min_samples)
     throw AnalysisError("ring-down: no decay above the noise floor");
   setSmoothedSpan(t, sm, i_start, i_end, &seg);
   seg.why = segmentWhy(env, seg, best_c, margin_db);
-  if (seg.n_used < kMinSamples ||
+  if (seg.n_used < options.min_samples ||
       !(seg.decay_db >=
-        std::max(options.min_decay_db, kMinDecaySd * seg.noise_sd_log * kDbPerNeper)))
+        std::max(options.min_decay_db, options.min_decay_sd * seg.noise_sd_log * kDbPerNeper)))
     throw AnalysisError("ring-down: no decay to fit (" + seg.why + ")");
   return seg;
 }

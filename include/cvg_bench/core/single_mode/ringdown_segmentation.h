@@ -43,6 +43,158 @@ struct RingdownSegmentationOptions {
   double dropout_depth_db = 3.0;
   /// Minimum decay in the span [dB] for a ring-down to be analysed.
   double min_decay_db = 3.0;
+  /// ... and at least this many robust sd of ln A (step 4) [multiples of noise_sd_log]. Set by
+  /// hand (commit 3dbfdf5), no recorded evidence.
+  double min_decay_sd = 10.0;
+  /// A ring-down needs this many samples: in the window's envelope, on the peak's grid, in the
+  /// span (step 4) [samples]. Set by hand (commit 3dbfdf5), no recorded evidence.
+  size_t min_samples = 8;
+
+  /// Step 1: drop-outs.
+  struct Dropouts {
+    /// Half-width of the running median the samples are read against [samples] (window 11). Set
+    /// by hand (commit 3dbfdf5), no recorded evidence.
+    int median_half = 5;
+    /// The noise scale is read from differences over the record's first half, at least this many
+    /// samples [samples]. Set by hand (commit 3dbfdf5), no recorded evidence.
+    size_t min_scale_samples = 8;
+    /// A drop-out lies this many robust sd of ln A below the running median, or dropout_depth_db,
+    /// whichever is deeper [multiples of noise_sd_log]. Set by hand (commit 3dbfdf5), no recorded
+    /// evidence.
+    double depth_sd = 8.0;
+    /// ... and this many local robust sd (MAD about the running median over 2 local_mad_half + 1
+    /// samples) [multiples], so that the Rice dips of additive noise near the floor are not taken
+    /// for drop-outs. Set by hand with the local depth (commit 2b6c82b), no recorded evidence for
+    /// the values.
+    double local_sd = 6.0;
+    /// Half-width of that local MAD [samples] (window 21). Commit 2b6c82b, no recorded evidence.
+    size_t local_mad_half = 10;
+  };
+  Dropouts dropouts;
+
+  /// The smoothed envelope the floor, plateau and settling are read on.
+  struct Smoothing {
+    /// Running median of half-width a divisor-th of the window [1, the window's sample count
+    /// divided by it] ...
+    size_t divisor = 100;
+    /// ... at least this many samples [samples]. Both set by hand (commit 3dbfdf5), no recorded
+    /// evidence.
+    int min_half = 2;
+    /// The smoothed envelope's peak is read on a grid of at most this many samples [samples]. Set
+    /// by hand (commit 3dbfdf5, first for a hinge fit since removed, dd42741), no recorded
+    /// evidence.
+    size_t peak_grid_points = 1500;
+  };
+  Smoothing smoothing;
+
+  /// Step 2: the noise floor.
+  struct NoiseFloor {
+    /// The tail level is the median smoothed level over the window's last tail_divisor-th
+    /// [1] ...
+    size_t tail_divisor = 10;
+    /// ... at least this many samples [samples]. Both set by hand (commit 3dbfdf5), no recorded
+    /// evidence.
+    size_t min_tail_samples = 4;
+    /// The floor fit starts stretch_top_db [dB] (or stretch_top_fraction of the peak's drop to
+    /// the tail level, whichever is less) above the tail level ...
+    double stretch_top_db = 25.0;
+    double stretch_top_fraction = 0.75;
+    /// ... when the decay goes on to stretch_bottom_db [dB] (or stretch_bottom_fraction of the
+    /// drop) above it over more than min_stretch_samples samples. The four levels and the count
+    /// were set with the floor test (commit 2cc791c: clean-record Q coverage on the tuning seeds
+    /// was 20/40 before it, floors missed); no comparison of other values is recorded.
+    double stretch_bottom_db = 10.0;
+    double stretch_bottom_fraction = 0.25;
+    size_t min_stretch_samples = 4;
+    /// A floor lies this far above the decay's straight continuation at the end [dB]. Commit
+    /// ed5996c (5 -> 3 dB with the evidence test; tuning seeds 1000000+: clean-record Q coverage
+    /// 20/40 -> 33/40); kept "as before" in 1016aed (docs/validation_ringdown.md, item 6).
+    double excess_db = 3.0;
+    /// The line-plus-floor model beats the straight line by this evidence [n ln(SSE_0 / SSE_1)].
+    /// Commit ed5996c (same run as excess_db).
+    double evidence = 30.0;
+    /// Past the line's crossing of the floor the scatter of ln A about a straight line exceeds
+    /// this [neper] (1.7 dB), else the bend is a slowing decay, not a floor. Noise alone
+    /// (Rayleigh) has sd pi / sqrt(24) = 0.64; on tuning floors 0.38 .. 0.79, on the slowing
+    /// decays 0.01 .. 0.11, beats up to 0.59 (commit 1016aed, docs/validation_ringdown.md item 6:
+    /// floors claimed without one 8/240 -> 1/240, spans cut above a suspected floor 44 -> 2).
+    double scatter = 0.2;
+    /// Without the evidence, a floor also confirms when that scatter is this many times the one
+    /// over the first half of the decay before the crossing [ratio] (the evidence alone failed
+    /// where the floor's deep Rayleigh dips dominate the sums of squares; commit 1016aed, same
+    /// tuning as scatter).
+    double scatter_ratio = 2.0;
+    /// The envelope reaches a confirmed floor within this of it [dB] (floor_start_s). Set by hand
+    /// (commit 3dbfdf5), no recorded evidence.
+    double reach_db = 3.0;
+  };
+  NoiseFloor noise_floor;
+
+  /// Step 3: the drive switch-off and the plateau.
+  struct Plateau {
+    /// The plateau level is the median over the window's first head_divisor-th [1] ...
+    size_t head_divisor = 20;
+    /// ... at least this many samples [samples]. Both set by hand (commit bde2bb5), no recorded
+    /// evidence.
+    size_t min_head_samples = 5;
+    /// The switch-off threshold lies max(switch_off_sd robust sd [multiples of noise_sd_log],
+    /// switch_off_min_db [dB]) below the plateau. Set by hand (commit bde2bb5: drive-off from the
+    /// first fall below the plateau level), no recorded evidence for the values.
+    double switch_off_sd = 6.0;
+    double switch_off_min_db = 0.1;
+    /// For a plateau that creeps, the switch-off is read this far below it [dB] when the
+    /// noise-sized threshold finds no plateau and no steady fall. Commit fe6d1d3: D060 of the
+    /// real development set (0.6 dB over 1.6 s) gets its plateau; tuning 123/154 unchanged.
+    double wide_switch_off_db = 1.0;
+    /// The crossing is read below the head's 1 / percentile_divisor quantile [1] (20: the 5th
+    /// percentile; a beating plateau dips below its median). Commit ab1f760: beat 16/19 -> 19/19
+    /// on tuning base 42000000 (docs/validation_ringdown.md item 7).
+    size_t percentile_divisor = 20;
+    /// The decay rate after the crossing is read over an after_divisor-th of the window [1] ...
+    size_t after_divisor = 20;
+    /// ... at least this many samples [samples]. Both set by hand (commit bde2bb5), no recorded
+    /// evidence.
+    size_t min_after_samples = 8;
+    /// Falling steadily: differences over a lag_divisor-th of the stretch before the crossing [1],
+    /// falling_share of them negative [fraction] (a beating plateau falls and rises). Set by hand
+    /// (commit faf2753, before its reporting run), no recorded evidence for the values.
+    size_t lag_divisor = 10;
+    double falling_share = 0.9;
+    /// ... and a mean rate before the crossing of rate_ratio of the one after or more [ratio]: a
+    /// record that starts inside a fast first stage has no plateau. Commit 6cee0d4: two_stage
+    /// 13/20 -> 19/20 on tuning base 41000000 (the rule as a whole; no other value recorded).
+    double rate_ratio = 0.3;
+    /// A plateau's crossing lies past this sample [samples] ...
+    size_t min_cross_index = 2;
+    /// ... and later than delay times the time the decay takes to fall by the threshold [ratio].
+    /// Both set by hand (commit bde2bb5), no recorded evidence.
+    double delay = 3.0;
+  };
+  Plateau plateau;
+
+  /// Step 3: detector settling after the drive-off.
+  struct Settling {
+    /// Settling is read on spans of more than this many samples [samples] ...
+    size_t min_span = 40;
+    /// ... within the first skip_db of decay [dB] (at most that is skipped), against the rate from
+    /// there to rate_end_db [dB] over more than min_rate_samples samples. Set by hand (commit
+    /// ca46f02), no recorded evidence for the values.
+    double skip_db = 3.0;
+    double rate_end_db = 13.0;
+    size_t min_rate_samples = 8;
+    /// The local rate is read over a rate_window_divisor-th of the window [1] (commit 9b14288,
+    /// was 200 in ca46f02; no comparison recorded) ...
+    size_t rate_window_divisor = 80;
+    /// ... at least this many samples [samples] (commit ca46f02, no recorded evidence) ...
+    size_t min_rate_window = 8;
+    /// ... and the span starts this many times the time to the rate's peak after the drive-off
+    /// [ratio] (a 2-pole filter leaves 0.25 dB after 2.5 time constants). Commit 9b14288;
+    /// docs/validation_ringdown.md ("Why gamma_nl is the hard cause"): skipping half as long gave
+    /// gamma_nl 23/30, gamma_a 28/30 on tuning base 41000000, worse.
+    double time_factor = 2.0;
+  };
+  Settling settling;
+
   std::vector<std::string> validate() const;
 };
 
