@@ -145,9 +145,10 @@ std::vector<std::string> RingdownSegmentationOptions::validate() const {
   if (!(dropout_depth_db > 0.0)) p.push_back("dropout_depth_db must be > 0 dB");
   if (!(min_decay_db > 0.0)) p.push_back("min_decay_db must be > 0 dB");
   // The divisors split a window's sample count (a zero would divide by zero).
-  for (const size_t d : {min_samples, smoothing.divisor, smoothing.peak_grid_points,
-                         noise_floor.tail_divisor, plateau.head_divisor, plateau.percentile_divisor,
-                         plateau.after_divisor, plateau.lag_divisor, settling.rate_window_divisor})
+  for (const size_t d :
+       {min_samples, smoothing.divisor, smoothing.peak_grid_points, noise_floor.tail_divisor,
+        plateau.head_divisor, plateau.percentile_divisor, plateau.after_divisor,
+        plateau.lag_divisor, settling.rate_window_divisor, tail.smooth_divisor, tail.run_divisor})
     if (d < 1) {
       p.push_back("min_samples and the segmentation's divisors must be >= 1");
       break;
@@ -621,13 +622,14 @@ void setSpan(const RingdownEnvelope& env, size_t i_start, size_t i_end, Ringdown
 /// wanders (the level falls at under half the decay rate up to the stretch), and an end past a
 /// floor that wanders (the stretch ends in a floor's scatter before the span does). Smooth bends
 /// (a damping law, two stages) and faster falls (a detection loss) are left to the models.
-void correctWithStraightSpan(const RingdownEnvelope& env, double margin_db, RingdownSegment* seg,
-                             std::ostringstream* why) {
+void correctWithStraightSpan(const RingdownEnvelope& env, double margin_db,
+                             const RingdownSegmentationOptions::StraightSpanRules& o,
+                             RingdownSegment* seg, std::ostringstream* why) {
   const StraightSpan ss = findStraightSpan(env.t_s, env.log_amplitude, seg->dropout);
-  if (!ss.ok || ss.span_db < 10.0) return;
+  if (!ss.ok || ss.span_db < o.min_correct_db) return;
   why->precision(4);
   size_t a = seg->i_start, b = seg->i_end;
-  if (ss.i_start > a && ss.i_start + 8 < b) {
+  if (ss.i_start > a && ss.i_start + o.min_gap_samples < b) {
     const double fall = levelNear(env, seg->dropout, a) - levelNear(env, seg->dropout, ss.i_start);
     const double expected = -ss.slope_db_s * (env.t_s[ss.i_start] - env.t_s[a]);
     // The lowest level before the stretch against its line extrapolated back: a detector's
@@ -638,12 +640,12 @@ void correctWithStraightSpan(const RingdownEnvelope& env, double margin_db, Ring
     for (size_t i = a; i < ss.i_start; ++i)
       under = std::max(under, c0 + ss.slope_db_s * (env.t_s[i] - env.t_s[ss.i_start]) -
                                   levelNear(env, seg->dropout, i));
-    if (under > 3.0 && ss.i_start - a <= (b - a) * 15 / 100) {
+    if (under > o.transient_dip_db && ss.i_start - a <= (b - a) * o.transient_max_percent / 100) {
       *why << "; the level dips " << under << " dB below the decay's line before "
            << env.t_s[ss.i_start] << " s and comes back (a detector's switch-off transient): "
            << "the span starts at " << env.t_s[ss.i_start] << " s";
       a = ss.i_start;
-    } else if (fall < 0.5 * expected) {
+    } else if (fall < o.creep_ratio * expected) {
       *why << "; the level falls " << fall << " dB from " << env.t_s[a] << " s to "
            << env.t_s[ss.i_start] << " s where the decay rate gives " << expected
            << " dB (drive still on or settling): the span starts at " << env.t_s[ss.i_start]
@@ -656,13 +658,13 @@ void correctWithStraightSpan(const RingdownEnvelope& env, double margin_db, Ring
   // where no floor was confirmed or suspected: one already ends the span 10 dB above it (on the
   // generator's reporting base 99417733 the cut there took 5 beats of 100 out of their span; on
   // the real development set 15 of its 17 cuts were on records without a confirmed floor).
-  if (!seg->has_floor && !std::isfinite(seg->suspected_floor_log_amplitude) && ss.i_end + 8 < b &&
-      ss.i_end > a + 8) {
+  if (!seg->has_floor && !std::isfinite(seg->suspected_floor_log_amplitude) &&
+      ss.i_end + o.min_gap_samples < b && ss.i_end > a + o.min_gap_samples) {
     std::vector<double> tt, yy;
     for (size_t i = ss.i_end; i < b; ++i)
       if (!seg->dropout[i] && std::isfinite(env.log_amplitude[i]))
         tt.push_back(env.t_s[i]), yy.push_back(env.log_amplitude[i] * kDbPerNeper);
-    if (tt.size() >= 8) {
+    if (tt.size() >= o.min_gap_samples) {
       std::vector<bool> keep(tt.size(), false);
       const double post = slopeOver(tt, yy, keep, 0, tt.size());
       // (The stretch's own reading of its end, flat over 30 % of its length past it, was tried
@@ -695,36 +697,38 @@ void correctWithStraightSpan(const RingdownEnvelope& env, double margin_db, Ring
 /// without the scatter growing (the relative noise stays), so it keeps its tail. The span then
 /// ends where the smoothed level leaves the line of its first three quarters by more than the
 /// tolerance for good (docs/validation_ringdown_real.md, "tails").
-void trimFloorTail(const RingdownEnvelope& env, RingdownSegment* seg, std::ostringstream* why) {
+void trimFloorTail(const RingdownEnvelope& env, const RingdownSegmentationOptions::Tail& o,
+                   RingdownSegment* seg, std::ostringstream* why) {
   std::vector<size_t> idx;
   for (size_t i = seg->i_start; i < seg->i_end; ++i)
     if (!seg->dropout[i] && std::isfinite(env.log_amplitude[i])) idx.push_back(i);
   const size_t n = idx.size();
-  if (n < 60) return;
+  if (n < o.min_samples) return;
   std::vector<double> t(n), y(n);
   for (size_t k = 0; k < n; ++k)
     t[k] = env.t_s[idx[k]], y[k] = env.log_amplitude[idx[k]] * kDbPerNeper;
   const std::vector<bool> none(n, false);
-  const std::vector<double> sm = runningMedian(y, none, std::max<int>(2, n / 60));
+  const std::vector<double> sm =
+      runningMedian(y, none, std::max<int>(o.min_smooth_half, n / o.smooth_divisor));
   const size_t q1 = n / 4, q2 = n / 2, q3 = 3 * n / 4;
   const double s_mid = slopeOver(t, sm, none, q1, q3);
   const double s_end = slopeOver(t, sm, none, q3, n);
-  if (!(s_mid < 0.0) || !(s_end > 0.5 * s_mid)) return;
+  if (!(s_mid < 0.0) || !(s_end > o.slowing_ratio * s_mid)) return;
   auto roughness = [&](size_t a, size_t b) {
     std::vector<double> d;
     for (size_t k = a + 1; k < b; ++k) d.push_back(std::fabs(y[k] - y[k - 1]));
     return kGaussianSdPerMad * median(d) / std::sqrt(2.0);
   };
   const double r_mid = roughness(q1, q3), r_end = roughness(q3, n);
-  if (!(r_end > 1.5 * r_mid)) return;
+  if (!(r_end > o.roughness_growth * r_mid)) return;
   // The line of the first three quarters; the tail leaves it for good where `run` consecutive
   // smoothed levels lie above it by more than the tolerance.
   Eigen::MatrixXd X(q3, 2);
   Eigen::VectorXd Y(q3);
   for (size_t k = 0; k < q3; ++k) X(k, 0) = 1.0, X(k, 1) = t[k] - t[0], Y(k) = sm[k];
   const Eigen::Vector2d c = X.colPivHouseholderQr().solve(Y);
-  const double tol = std::max(1.5, 4.0 * r_mid);
-  const size_t run = std::max<size_t>(3, n / 100);
+  const double tol = std::max(o.tolerance_db, o.tolerance_sd * r_mid);
+  const size_t run = std::max<size_t>(o.min_run, n / o.run_divisor);
   size_t cut = n, above = 0;
   for (size_t k = q2; k < n; ++k) {
     if (sm[k] - c(0) - c(1) * (t[k] - t[0]) > tol) {
@@ -738,7 +742,7 @@ void trimFloorTail(const RingdownEnvelope& env, RingdownSegment* seg, std::ostri
   }
   if (cut >= n) return;
   const double kept_db = -c(1) * (t[cut - 1] - t[0]);
-  if (kept_db < 10.0) return;
+  if (kept_db < o.min_kept_db) return;
   why->precision(4);
   *why << "; from " << t[cut] << " s the level leaves the decay's line upwards (over its last "
        << "quarter it falls at " << s_end << " dB/s against " << s_mid << " dB/s, its scatter "
@@ -773,15 +777,16 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
     seg.i_start += w.first;
     seg.i_end += w.first;
     why << (w.why.empty() ? "" : "; ") << seg.why;
-    correctWithStraightSpan(env, options.floor_margin_db, &seg, &why);
+    correctWithStraightSpan(env, options.floor_margin_db, options.straight_span, &seg, &why);
     if (!seg.has_floor && !std::isfinite(seg.suspected_floor_log_amplitude))
-      trimFloorTail(env, &seg, &why);
+      trimFloorTail(env, options.tail, &seg, &why);
   } else {
-    // The plateau-and-floor reading found no decay: a straight stretch of 10 dB or more is one.
+    // The plateau-and-floor reading found no decay: a straight stretch of 10 dB (min_fallback_db)
+    // or more is one.
     std::string window_why = w.why;
     for (size_t i = w.first; i < w.last; ++i) dropout[i] = !std::isfinite(env.log_amplitude[i]);
     StraightSpan ss = findStraightSpan(env.t_s, env.log_amplitude, dropout);
-    if (!ss.ok || ss.span_db < 10.0) {
+    if (!ss.ok || ss.span_db < options.straight_span.min_fallback_db) {
       // None in the window either: the whole record, from each of its drive-on stretches (a
       // decay followed by a re-excitation, or by a clipped stretch the window took for one).
       std::vector<bool> all(env.size());
@@ -789,7 +794,7 @@ RingdownSegment segmentRingdown(const RingdownEnvelope& env,
       StraightSpanOptions every;
       every.all_peaks = true;
       const StraightSpan whole = findStraightSpan(env.t_s, env.log_amplitude, all, every);
-      if (!whole.ok || whole.span_db < 10.0)
+      if (!whole.ok || whole.span_db < options.straight_span.min_fallback_db)
         throw AnalysisError(refusal + (w.why.empty() ? "" : " [" + w.why + "]"));
       ss = whole;
       dropout = std::move(all);

@@ -33,15 +33,20 @@
 namespace cvg_bench {
 
 struct RingdownSegmentationOptions {
-  /// Fit down to this far above the noise floor [dB], 3..40.
+  /// Fit down to this far above the noise floor [dB], 3..40. Set in commit 3dbfdf5; the floor
+  /// term of the model is under 1e-5 Np there (docs/validation_ringdown.md, method notes).
   double floor_margin_db = 10.0;
   /// ... unless the decay rises less than floor_margin_db + short_decay_db above the floor: then
-  /// the margin leaves short_decay_db of decay, but is not under min_floor_margin_db [dB].
+  /// the margin leaves short_decay_db of decay, but is not under min_floor_margin_db [dB]. Commit
+  /// a42d595 (docs/validation_ringdown_real.md, "29 Nov, evening" item 3: D008's span 3 -> 6.9
+  /// dB, Q 1.75x -> 1.35x).
   double short_decay_db = 10.0;
   double min_floor_margin_db = 4.0;
-  /// A drop-out lies at least this far below its neighbours' median [dB] (and 8 robust sd).
+  /// A drop-out lies at least this far below its neighbours' median [dB] (and 8 robust sd). Set
+  /// by hand (commit 3dbfdf5), no recorded evidence.
   double dropout_depth_db = 3.0;
-  /// Minimum decay in the span [dB] for a ring-down to be analysed.
+  /// Minimum decay in the span [dB] for a ring-down to be analysed. Set by hand (commit
+  /// 3dbfdf5), no recorded evidence.
   double min_decay_db = 3.0;
   /// ... and at least this many robust sd of ln A (step 4) [multiples of noise_sd_log]. Set by
   /// hand (commit 3dbfdf5), no recorded evidence.
@@ -74,8 +79,7 @@ struct RingdownSegmentationOptions {
 
   /// The smoothed envelope the floor, plateau and settling are read on.
   struct Smoothing {
-    /// Running median of half-width a divisor-th of the window [1, the window's sample count
-    /// divided by it] ...
+    /// A running median whose half-width is the window's sample count over divisor [1] ...
     size_t divisor = 100;
     /// ... at least this many samples [samples]. Both set by hand (commit 3dbfdf5), no recorded
     /// evidence.
@@ -194,6 +198,62 @@ struct RingdownSegmentationOptions {
     double time_factor = 2.0;
   };
   Settling settling;
+
+  /// The longest straight stretch (ringdown_straight_span.h) correcting the span of steps 1-4
+  /// (commit 3d3ff4f: tuning part 83 -> 99 of 154 clean within 5 %, the rules together; no
+  /// comparison of the values below is recorded unless said).
+  struct StraightSpanRules {
+    /// A stretch corrects the span from this many dB of decay [dB] (commit 3d3ff4f).
+    double min_correct_db = 10.0;
+    /// When steps 1-4 find no decay, a stretch of this many dB or more is one [dB] (in the window,
+    /// else from each drive-on stretch of the whole record; commit f7676e1: clean tuning refusals
+    /// 4 -> 0, 115 -> 119 of 154).
+    double min_fallback_db = 10.0;
+    /// The stretch starts more than this many samples before the span's end; to end the span at
+    /// a floor, its end lies more than this many samples inside the span on both sides and the
+    /// level past it is read on at least this many usable samples [samples] (commit 3d3ff4f).
+    size_t min_gap_samples = 8;
+    /// A start on a switch-off transient: the level before the stretch dips more than this below
+    /// the stretch's line extrapolated back [dB] ...
+    double transient_dip_db = 3.0;
+    /// ... when the stretch starts within the span's first transient_max_percent [%] (commit
+    /// 3d3ff4f).
+    size_t transient_max_percent = 15;
+    /// A start on a creeping plateau: the level falls to the stretch at under creep_ratio of what
+    /// the stretch's rate gives [ratio] (commit 3d3ff4f; docs/validation_ringdown_real.md, "What
+    /// was built" item 2: "under half the decay rate").
+    double creep_ratio = 0.5;
+  };
+  StraightSpanRules straight_span;
+
+  /// A tail that bends into a floor nobody confirmed (docs/validation_ringdown_real.md, 28 Nov
+  /// item 3; commit 2307bea: tuning part 119 -> 122 of 154 clean within 5 %, the generator's
+  /// tuning base 41000000 fires on none of 210 records). The values were set with the rule; no
+  /// comparison of other values is recorded.
+  struct Tail {
+    /// Read on spans of at least this many usable samples [samples] ...
+    size_t min_samples = 60;
+    /// ... smoothed by a running median of half-width a smooth_divisor-th of them [1], at least
+    /// min_smooth_half samples [samples].
+    size_t smooth_divisor = 60;
+    int min_smooth_half = 2;
+    /// Over the last quarter the level falls at under slowing_ratio of the middle half's rate
+    /// [ratio] ("under half") ...
+    double slowing_ratio = 0.5;
+    /// ... while its sample-to-sample scatter grows over roughness_growth times the middle's
+    /// [ratio] ("grows by half").
+    double roughness_growth = 1.5;
+    /// The tail leaves the line of the first three quarters by more than max(tolerance_db [dB],
+    /// tolerance_sd times the middle's scatter) ...
+    double tolerance_db = 1.5;
+    double tolerance_sd = 4.0;
+    /// ... for max(min_run [samples], a run_divisor-th of the samples [1]) in a row.
+    size_t min_run = 3;
+    size_t run_divisor = 100;
+    /// The cut keeps at least this much decay, else the span stays [dB].
+    double min_kept_db = 10.0;
+  };
+  Tail tail;
 
   std::vector<std::string> validate() const;
 };
