@@ -12,31 +12,6 @@
 namespace cvg_bench {
 namespace {
 
-/// A record under this many samples is kept whole (no window is read).
-constexpr size_t kMinRecordSamples = 16;
-/// The running median's half-width: a kSmoothDivisor-th of the record, at least kMinSmoothHalf.
-constexpr size_t kSmoothDivisor = 200;
-constexpr int kMinSmoothHalf = 2;
-/// Step 3: the head compared with the drive level is a kHeadDivisor-th of the record (2 %), at
-/// least kMinHeadSamples samples.
-constexpr size_t kHeadDivisor = 50;
-constexpr long kMinHeadSamples = 5;
-/// Step 6: the roughness is the median |second difference| over 2 kRoughnessHalf + 1 samples.
-constexpr long kRoughnessHalf = 5;
-/// Step 6: a noiseless tail covers a kTailDivisor-th of the window (at least kMinTailSamples
-/// samples) and is compared with as many samples before it.
-constexpr size_t kTailDivisor = 10;
-constexpr size_t kMinTailSamples = 10;
-/// Step 6: a noiseless tail lies this far below the peak [dB].
-constexpr double kTailBelowPeakDb = 10.0;
-/// Step 6: the stretch before a noiseless tail is this many times rougher.
-constexpr double kTailRoughnessRatio = 30.0;
-/// Step 5: a cut plateau keeps at least this many samples.
-constexpr size_t kMinPlateauSamples = 8;
-/// A window under a kMinWindowDivisor-th of the record or kMinWindowSamples samples is no window.
-constexpr size_t kMinWindowDivisor = 20;
-constexpr size_t kMinWindowSamples = 16;
-
 /// Median of the finite values of y[a, b) (clipped to the record); NaN when none.
 double medianOf(const std::vector<double>& y, long a, long b) {
   std::vector<double> w;
@@ -57,7 +32,8 @@ struct Step {
 };
 
 /// Sharp steps of the level y_db at half-width h (step 1 of the header), in time order.
-std::vector<Step> stepsAtScale(const std::vector<double>& y_db, long h, double min_jump) {
+std::vector<Step> stepsAtScale(const std::vector<double>& y_db, long h, double min_jump,
+                               const RingdownWindowOptions& o) {
   std::vector<Step> steps;
   const long n = static_cast<long>(y_db.size());
   for (long i = 2 * h; i + 2 * h <= n; ++i) {
@@ -65,10 +41,14 @@ std::vector<Step> stepsAtScale(const std::vector<double>& y_db, long h, double m
     const double jump = std::fabs(R - L);
     if (!(jump >= min_jump)) continue;
     const double L2 = medianOf(y_db, i - 2 * h, i - h), R2 = medianOf(y_db, i + h, i + 2 * h);
-    if (!(std::fabs(L - L2) < jump / 3.0 && std::fabs(R2 - R) < jump / 3.0)) continue;
-    // Local scatter of the differences over 10 samples each side, the jump itself left out.
+    if (!(std::fabs(L - L2) < jump / o.step_side_divisor &&
+          std::fabs(R2 - R) < jump / o.step_side_divisor))
+      continue;
+    // Local scatter of the differences over step_scatter_half samples each side, the jump itself
+    // left out.
     std::vector<double> d;
-    for (long k = std::max(1L, i - 10); k < std::min(n, i + 11); ++k)
+    for (long k = std::max(1L, i - o.step_scatter_half);
+         k < std::min(n, i + o.step_scatter_half + 1); ++k)
       if (k != i && std::isfinite(y_db[k]) && std::isfinite(y_db[k - 1]))
         d.push_back(std::fabs(y_db[k] - y_db[k - 1]));
     double sd = 0.0;
@@ -77,7 +57,7 @@ std::vector<Step> stepsAtScale(const std::vector<double>& y_db, long h, double m
       sd = kGaussianSdPerMad * d[d.size() / 2];
     }
     const double sharp = jump / std::max(sd, 1e-12);
-    if (sharp < 4.0) continue;
+    if (sharp < o.step_min_sharpness) continue;
     // Keep the largest jump of a cluster of adjacent candidates.
     if (!steps.empty() && static_cast<long>(steps.back().i) + h >= i) {
       if (jump > std::fabs(steps.back().right - steps.back().left))
@@ -95,17 +75,17 @@ std::vector<Step> stepsAtScale(const std::vector<double>& y_db, long h, double m
 /// 3-sample comparison reads as a slope). A ramp's i0 is its first sample, i the first after it.
 std::vector<Step> findSteps(const std::vector<double>& y_db, const RingdownWindowOptions& o) {
   const long h = std::max(1, o.step_half);
-  std::vector<Step> steps = stepsAtScale(y_db, h, o.step_db);
-  for (const int scale : {4, 10}) {
+  std::vector<Step> steps = stepsAtScale(y_db, h, o.step_db, o);
+  for (const int scale : o.ramp_scales) {
     const long H = h * scale;
     if (scale > o.ramp_scale) break;
-    for (Step r : stepsAtScale(y_db, H, o.end_step_db)) {
+    for (Step r : stepsAtScale(y_db, H, o.end_step_db, o)) {
       // Only rises: a fall of 20 dB over 10-30 samples is as often the decay itself (a fast first
       // stage, a short record) as a step (the development set's D201, D204: -60 dB "ramps").
       if (!(r.right > r.left)) continue;
       // The ramp's ends: the last sample at the left level and the first at the right one (within
-      // a tenth of the jump), searched within H samples of the step.
-      const double tol = 0.1 * std::fabs(r.right - r.left);
+      // ramp_end_tolerance of the jump), searched within H samples of the step.
+      const double tol = o.ramp_end_tolerance * std::fabs(r.right - r.left);
       size_t a = r.i, b = r.i;
       while (a > 0 && r.i - a < size_t(H) &&
              !(std::isfinite(y_db[a - 1]) && std::fabs(y_db[a - 1] - r.left) <= tol))
@@ -152,7 +132,7 @@ struct Levels {
 };
 
 /// The levels of the record y (ln A).
-Levels readLevels(const std::vector<double>& y) {
+Levels readLevels(const std::vector<double>& y, const RingdownWindowOptions& o) {
   const size_t n = y.size();
   std::vector<double> y_db(n);
   std::vector<bool> skip(n);
@@ -161,7 +141,7 @@ Levels readLevels(const std::vector<double>& y) {
     skip[i] = !std::isfinite(y[i]);
   }
   Levels lv;
-  lv.sm = runningMedian(y_db, skip, std::max<int>(kMinSmoothHalf, n / kSmoothDivisor));
+  lv.sm = runningMedian(y_db, skip, std::max<int>(o.min_smooth_half, n / o.smooth_divisor));
   lv.y_db = std::move(y_db);
   const std::vector<double>& sm = lv.sm;
   size_t i_peak = 0;
@@ -181,11 +161,13 @@ bool readStartUnderDrive(const std::vector<double>& t, const Levels& lv,
   const size_t n = lv.sm.size();
   const std::vector<double>& sm = lv.sm;
   const double top = lv.top;
-  const double head = medianOf(sm, 0, std::max<long>(kMinHeadSamples, n / kHeadDivisor));
+  const double head = medianOf(sm, 0, std::max<long>(o.min_head_samples, n / o.head_divisor));
   const bool started_under = top - head > o.start_below_db;
   if (started_under) {
     size_t j = lv.i_peak;
-    while (j > 0 && !(std::isfinite(sm[j - 1]) && sm[j - 1] < top - 0.5 * o.near_top_db)) --j;
+    while (j > 0 &&
+           !(std::isfinite(sm[j - 1]) && sm[j - 1] < top - o.start_rise_fraction * o.near_top_db))
+      --j;
     w->first = j;
     *why << "the record starts " << top - head << " dB under the drive level (floor before the "
          << "drive or its ramp-up): read from " << t[j] << " s";
@@ -274,9 +256,10 @@ void preferEarlierBurst(const std::vector<double>& t, const Levels& lv,
 }
 
 /// Step 6: a noiseless tail: from some sample to the window's end the local roughness (median
-/// |second difference| over 11 samples) stays under tail_roughness_db, 10 dB or more below the
-/// peak, over a tenth of the window at least, while the tenth before it is 30 times rougher. No
-/// instrument records that after a measured decay; exports append it (a fitted or padded curve).
+/// |second difference| over 2 roughness_half + 1 samples) stays under tail_roughness_db,
+/// tail_below_peak_db or more below the peak, over a tail_divisor-th of the window at least, while
+/// as many samples before it are tail_roughness_ratio times rougher. No instrument records that
+/// after a measured decay; exports append it (a fitted or padded curve).
 void cutNoiselessTail(const std::vector<double>& t, const Levels& lv,
                       const RingdownWindowOptions& o, RingdownWindow* w, std::ostringstream* why) {
   const std::vector<double>& y_db = lv.y_db;
@@ -285,16 +268,16 @@ void cutNoiselessTail(const std::vector<double>& t, const Levels& lv,
   std::vector<double> e2(n, std::numeric_limits<double>::quiet_NaN()), rough(n, 0.0);
   for (size_t i = 1; i + 1 < n; ++i) e2[i] = std::fabs(y_db[i + 1] - 2.0 * y_db[i] + y_db[i - 1]);
   for (size_t i = 0; i < n; ++i)
-    rough[i] = medianOf(e2, long(i) - kRoughnessHalf, long(i) + kRoughnessHalf + 1);
+    rough[i] = medianOf(e2, long(i) - o.roughness_half, long(i) + o.roughness_half + 1);
   size_t k = w->last;
   while (k > std::max(w->first, lv.i_peak) + 1 &&
          (!std::isfinite(rough[k - 1]) || rough[k - 1] <= o.tail_roughness_db))
     --k;
-  const size_t tenth = std::max<size_t>(kMinTailSamples, (w->last - w->first) / kTailDivisor);
+  const size_t tenth = std::max<size_t>(o.min_tail_samples, (w->last - w->first) / o.tail_divisor);
   const double inside = medianOf(rough, k, w->last);
   const double before = medianOf(rough, long(k) - long(tenth), k);
   if (w->last - k >= tenth && k > tenth && std::isfinite(sm[k]) &&
-      sm[k] < lv.top - kTailBelowPeakDb && before >= kTailRoughnessRatio * inside) {
+      sm[k] < lv.top - o.tail_below_peak_db && before >= o.tail_roughness_ratio * inside) {
     *why << (why->tellp() > 0 ? "; " : "") << "from " << t[k] << " s the level is noiseless "
          << "(roughness " << inside << " dB against " << before << " dB before it: a curve the "
          << "export appended, not a measurement): the record is read up to there";
@@ -312,8 +295,8 @@ void cutLongPlateau(const std::vector<double>& t, const Levels& lv, const Ringdo
   for (size_t i = w->first; i < w->last; ++i)
     if (std::isfinite(sm[i]) && sm[i] >= lv.top - o.off_below_db) i_off = i;
   const size_t keep = static_cast<size_t>(o.plateau_fraction * double(w->last - i_off));
-  if (i_off > w->first + std::max<size_t>(keep, kMinPlateauSamples)) {
-    w->first = i_off - std::max<size_t>(keep, kMinPlateauSamples);
+  if (i_off > w->first + std::max<size_t>(keep, o.min_plateau_samples)) {
+    w->first = i_off - std::max<size_t>(keep, o.min_plateau_samples);
     *why << (why->tellp() > 0 ? "; " : "") << "the drive level is last held at " << t[i_off]
          << " s: read from " << t[w->first] << " s";
   }
@@ -326,8 +309,8 @@ RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vecto
   const size_t n = y.size();
   RingdownWindow w;
   w.last = n;
-  if (n < kMinRecordSamples || t.size() != n) return w;
-  const Levels lv = readLevels(y);
+  if (n < o.min_record_samples || t.size() != n) return w;
+  const Levels lv = readLevels(y, o);
   if (!std::isfinite(lv.top)) return w;
   std::ostringstream why;
   why.precision(4);
@@ -344,8 +327,9 @@ RingdownWindow findRingdownWindow(const std::vector<double>& t, const std::vecto
   // beats the envelope comes back within off_below_db of the peak after the switch-off, and the
   // cut took the plateau and the first beats (base 99530119: 3 of 20 beats without a floor).
   if (w.last > w.first && started_under) cutLongPlateau(t, lv, o, &w, &why);
-  // A window too short to hold a ring-down (a twentieth of the record, 16 samples) is no window.
-  if (w.last < w.first + std::max<size_t>(kMinWindowSamples, n / kMinWindowDivisor))
+  // A window too short to hold a ring-down (a min_window_divisor-th of the record,
+  // min_window_samples samples) is no window.
+  if (w.last < w.first + std::max<size_t>(o.min_window_samples, n / o.min_window_divisor))
     w.first = 0, w.last = n, why.str("");
   w.why = why.str();
   return w;
