@@ -16,37 +16,10 @@
 namespace cvg_bench {
 namespace {
 
-/// Filter orders tried: 1..kMaxOrder equal real poles.
+/// The orders whose closed form (ringdownFilterPowerCorrelation) and correlation time are
+/// tabulated: 1..kMaxOrder equal real poles (RingdownDetectorFilterOptions::max_order is at most
+/// this).
 constexpr int kMaxOrder = 4;
-
-/// The span's last samples whose median gives the level at its end.
-constexpr size_t kEndLevelSamples = 9;
-/// The level above the floor at the span's end [dB] when none of those samples is usable.
-constexpr double kDefaultAboveFloorDb = 10.0;
-/// The floor stretch starts where the decay's straight continuation lies this far below the floor
-/// [dB].
-constexpr double kBelowFloorDb = 6.0;
-/// A floor stretch (and its valid samples) must number at least this many samples.
-constexpr int kMinFloorSamples = 120;
-/// Sampling is uniform when every interval is within this fraction of the median one.
-constexpr double kSamplingTolerance = 0.01;
-/// The autocorrelation is taken over at most this many lags, and over at most a kLagsDivisor-th of
-/// the stretch.
-constexpr size_t kMaxLags = 300;
-constexpr size_t kLagsDivisor = 4;
-/// The lags end where the autocorrelation falls under this (K of the header).
-constexpr double kCorrelationEnd = 0.05;
-/// Under this correlation at lag 1 the filter is shorter than the sample interval (negligible).
-constexpr double kMinLag1Correlation = 0.2;
-/// The log grid of T in samples: this many nodes from kGridMinSamples to kGridMaxSamples.
-constexpr int kGridNodes = 160;
-constexpr double kGridMinSamples = 0.05;
-constexpr double kGridMaxSamples = 400.0;
-/// Golden-section iterations between the best node's neighbours.
-constexpr int kGoldenIterations = 40;
-/// A floor stretch under this many filter lengths (n T) gives an autocorrelation too noisy to
-/// trust.
-constexpr double kMinFilterLengths = 8.0;
 
 double median(const std::vector<double>& v) {
   return sampleMedian(v);
@@ -67,14 +40,16 @@ double correlationTime(int order) {
 /// Sum of squares of the power autocorrelation r[1..K] against (rho_n(k / T)^2 - b) / (1 - b)
 /// (T in samples): b >= 0 is the bias of an autocorrelation taken about an estimated mean and
 /// trend (about twice the correlation time over the stretch's length m), fitted in closed form,
-/// at most 4 correlation times over m and 0.15.
-double correlationMisfit(int order, double t_samples, const std::vector<double>& r, double m) {
+/// at most bias_correlation_times correlation times over m and max_bias.
+double correlationMisfit(int order, double t_samples, const std::vector<double>& r, double m,
+                         const RingdownDetectorFilterOptions& o) {
   double sxy = 0.0, sxx = 0.0;
   for (size_t k = 1; k < r.size(); ++k) {
     const double x = ringdownFilterPowerCorrelation(order, k / t_samples) - 1.0;
     sxy += x * (r[k] - 1.0), sxx += x * x;
   }
-  const double b_max = std::min(0.15, 4.0 * correlationTime(order) * t_samples / m);
+  const double b_max =
+      std::min(o.max_bias, o.bias_correlation_times * correlationTime(order) * t_samples / m);
   const double alpha = std::min(1.0 / (1.0 - b_max), std::max(1.0, sxx > 0.0 ? sxy / sxx : 1.0));
   double s = 0.0;
   for (size_t k = 1; k < r.size(); ++k) {
@@ -87,18 +62,18 @@ double correlationMisfit(int order, double t_samples, const std::vector<double>&
 
 /// Step 1: the floor stretch's first sample.
 size_t floorStretchStart(const RingdownEnvelope& env, const RingdownSegment& seg,
-                         double decay_rate_1_s) {
+                         double decay_rate_1_s, const RingdownDetectorFilterOptions& o) {
   const auto& t = env.t_s;
   const auto& y = env.log_amplitude;
-  // Level at the span's end above the floor; the stretch starts 6 dB below the floor on the
-  // decay's straight continuation.
+  // Level at the span's end above the floor; the stretch starts below_floor_db below the floor
+  // on the decay's straight continuation.
   std::vector<double> last;
-  for (size_t i = seg.i_end > kEndLevelSamples ? seg.i_end - kEndLevelSamples : 0;
+  for (size_t i = seg.i_end > o.end_level_samples ? seg.i_end - o.end_level_samples : 0;
        i < seg.i_end && i < y.size(); ++i)
     if (!seg.dropout[i] && std::isfinite(y[i])) last.push_back(y[i]);
-  const double above =
-      last.empty() ? kDefaultAboveFloorDb / kDbPerNeper : median(last) - seg.floor_log_amplitude;
-  const double t_a = seg.t_end_s + (above + kBelowFloorDb / kDbPerNeper) / decay_rate_1_s;
+  const double above = last.empty() ? o.default_above_floor_db / kDbPerNeper
+                                    : median(last) - seg.floor_log_amplitude;
+  const double t_a = seg.t_end_s + (above + o.below_floor_db / kDbPerNeper) / decay_rate_1_s;
   size_t a = 0;
   while (a < t.size() && t[a] < t_a) ++a;
   return a;
@@ -111,9 +86,9 @@ struct FloorPower {
   int nv = 0;               ///< valid samples
 };
 
-/// Step 3 (the fit of c0 and c1 only with kMinFloorSamples valid samples or more).
+/// Step 3 (the fit of c0 and c1 only with min_floor_samples valid samples or more).
 FloorPower floorPower(const RingdownEnvelope& env, const RingdownSegment& seg,
-                      double decay_rate_1_s, size_t a, size_t m) {
+                      double decay_rate_1_s, size_t a, size_t m, int min_floor_samples) {
   const auto& t = env.t_s;
   const auto& y = env.log_amplitude;
   FloorPower out;
@@ -133,7 +108,7 @@ FloorPower floorPower(const RingdownEnvelope& env, const RingdownSegment& seg,
     X(nv, 0) = 1.0, X(nv, 1) = std::exp(-2.0 * decay_rate_1_s * (t[i] - t[a]));
     p[k] = P(nv), ++nv;
   }
-  if (nv < kMinFloorSamples) return out;
+  if (nv < min_floor_samples) return out;
   const Eigen::VectorXd c = X.topRows(nv).colPivHouseholderQr().solve(P.head(nv));
   for (size_t k = 0; k < m; ++k)
     if (valid[k]) p[k] -= c(0) + c(1) * std::exp(-2.0 * decay_rate_1_s * (t[a + k] - t[a]));
@@ -141,8 +116,8 @@ FloorPower floorPower(const RingdownEnvelope& env, const RingdownSegment& seg,
 }
 
 /// Step 4: the power's autocorrelation r[0..K] (r[0] = 1) over the valid pairs, normalized by its
-/// mean square, up to k_max lags or the first under kCorrelationEnd.
-std::vector<double> powerAutocorrelation(const FloorPower& fp, int k_max) {
+/// mean square, up to k_max lags or the first under correlation_end.
+std::vector<double> powerAutocorrelation(const FloorPower& fp, int k_max, double correlation_end) {
   const std::vector<double>& p = fp.p;
   const std::vector<bool>& valid = fp.valid;
   const size_t m = p.size();
@@ -158,28 +133,30 @@ std::vector<double> powerAutocorrelation(const FloorPower& fp, int k_max) {
     for (size_t k = 0; k + lag < m; ++k)
       if (valid[k] && valid[k + lag]) s += p[k] * p[k + lag], ++cnt;
     r.push_back(cnt > 0 ? s / cnt / std::max(var, 1e-300) : 0.0);
-    if (r.back() < kCorrelationEnd) break;
+    if (r.back() < correlation_end) break;
   }
   return r;
 }
 
 /// T [samples] of the given order that fits r best.
-double fitTimeConstant(int order, const std::vector<double>& r, size_t m) {
+double fitTimeConstant(int order, const std::vector<double>& r, size_t m,
+                       const RingdownDetectorFilterOptions& o) {
   // Log grid of T in samples, then golden section between the neighbours of the best node.
-  const int ng = kGridNodes;
-  const double lo = std::log(kGridMinSamples), hi = std::log(kGridMaxSamples);
+  const int ng = o.grid_nodes;
+  const double lo = std::log(o.grid_min_samples), hi = std::log(o.grid_max_samples);
   int kb = 0;
   double eb = std::numeric_limits<double>::infinity();
   for (int g = 0; g < ng; ++g) {
-    const double e = correlationMisfit(order, std::exp(lo + (hi - lo) * g / (ng - 1)), r, m);
+    const double e = correlationMisfit(order, std::exp(lo + (hi - lo) * g / (ng - 1)), r, m, o);
     if (e < eb) eb = e, kb = g;
   }
   double u0 = lo + (hi - lo) * std::max(0, kb - 1) / (ng - 1);
   double u1 = lo + (hi - lo) * std::min(ng - 1, kb + 1) / (ng - 1);
   const double gr = 0.5 * (std::sqrt(5.0) - 1.0);
-  for (int it = 0; it < kGoldenIterations; ++it) {
+  for (int it = 0; it < o.golden_iterations; ++it) {
     const double x1 = u1 - gr * (u1 - u0), x2 = u0 + gr * (u1 - u0);
-    if (correlationMisfit(order, std::exp(x1), r, m) < correlationMisfit(order, std::exp(x2), r, m))
+    if (correlationMisfit(order, std::exp(x1), r, m, o) <
+        correlationMisfit(order, std::exp(x2), r, m, o))
       u1 = x2;
     else
       u0 = x1;
@@ -187,14 +164,15 @@ double fitTimeConstant(int order, const std::vector<double>& r, size_t m) {
   return std::exp(0.5 * (u0 + u1));
 }
 
-/// Step 5: the order (1..kMaxOrder) and time constant [s] of the best fit into f; returns its sum
+/// Step 5: the order (1..max_order) and time constant [s] of the best fit into f; returns its sum
 /// of squares (infinite, f untouched, when no order gives a finite one).
 double fitFilterShape(const std::vector<double>& r, size_t m, double dt,
-                      RingdownDetectorFilter* f) {
+                      const RingdownDetectorFilterOptions& o, RingdownDetectorFilter* f) {
   double best = std::numeric_limits<double>::infinity();
-  for (int order = 1; order <= kMaxOrder; ++order) {
-    const double ts = fitTimeConstant(order, r, m);
-    const double e = correlationMisfit(order, ts, r, m);
+  const int max_order = std::min(o.max_order, kMaxOrder);
+  for (int order = 1; order <= max_order; ++order) {
+    const double ts = fitTimeConstant(order, r, m, o);
+    const double e = correlationMisfit(order, ts, r, m, o);
     if (e < best) best = e, f->order = order, f->time_constant_s = ts * dt;
   }
   return best;
@@ -217,7 +195,8 @@ double ringdownFilterPowerCorrelation(int order, double x) {
 }
 
 RingdownDetectorFilter estimateDetectorFilter(const RingdownEnvelope& env,
-                                              const RingdownSegment& seg, double decay_rate_1_s) {
+                                              const RingdownSegment& seg, double decay_rate_1_s,
+                                              const RingdownDetectorFilterOptions& o) {
   RingdownDetectorFilter f;
   f.source = "none";
   auto none = [&f](const std::string& why) {
@@ -229,12 +208,14 @@ RingdownDetectorFilter estimateDetectorFilter(const RingdownEnvelope& env,
   if (!seg.has_floor) return none("no noise floor in the record");
   if (!(decay_rate_1_s > 0.0)) return none("no positive decay rate");
   const auto& t = env.t_s;
-  // 1. The floor stretch, from 6 dB below the floor on the decay's straight continuation.
-  const size_t a = floorStretchStart(env, seg, decay_rate_1_s);
+  // 1. The floor stretch, from below_floor_db below the floor on the decay's straight
+  // continuation.
+  const size_t a = floorStretchStart(env, seg, decay_rate_1_s, o);
   const size_t m = t.size() - std::min(a, t.size());
-  if (m < kMinFloorSamples) {
+  if (m < static_cast<size_t>(o.min_floor_samples)) {
     std::ostringstream w;
-    w << m << " samples of floor 6 dB below the decay's continuation, under 120";
+    w << m << " samples of floor " << o.below_floor_db
+      << " dB below the decay's continuation, under " << o.min_floor_samples;
     return none(w.str());
   }
   // 2. Uniform sampling over it.
@@ -242,33 +223,37 @@ RingdownDetectorFilter estimateDetectorFilter(const RingdownEnvelope& env,
   for (size_t i = a + 1; i < t.size(); ++i) dts.push_back(t[i] - t[i - 1]);
   const double dt = median(dts);
   for (double d : dts)
-    if (std::fabs(d - dt) > kSamplingTolerance * dt)
+    if (std::fabs(d - dt) > o.sampling_tolerance * dt)
       return none("sampling not uniform in the floor");
   // 3. The floor's power less the residual signal and the mean.
-  const FloorPower fp = floorPower(env, seg, decay_rate_1_s, a, m);
-  if (fp.nv < kMinFloorSamples) return none("under 120 valid floor samples");
-  // 4. Its autocorrelation, up to where it falls under kCorrelationEnd.
-  const int k_max = static_cast<int>(std::min<size_t>(kMaxLags, m / kLagsDivisor));
-  const std::vector<double> r = powerAutocorrelation(fp, k_max);
+  const FloorPower fp = floorPower(env, seg, decay_rate_1_s, a, m, o.min_floor_samples);
+  if (fp.nv < o.min_floor_samples)
+    return none("under " + std::to_string(o.min_floor_samples) + " valid floor samples");
+  // 4. Its autocorrelation, up to where it falls under correlation_end.
+  const int k_max = static_cast<int>(std::min<size_t>(o.max_lags, m / o.lags_divisor));
+  const std::vector<double> r = powerAutocorrelation(fp, k_max, o.correlation_end);
   f.n_samples = fp.nv;
   f.n_lags = static_cast<int>(r.size()) - 1;
-  if (r.size() < 2 || r[1] < kMinLag1Correlation) {
+  if (r.size() < 2 || r[1] < o.min_lag1_correlation) {
     std::ostringstream w;
     w.precision(3);
-    w << "floor power correlation at lag 1 is " << (r.size() > 1 ? r[1] : 0.0)
-      << ", under 0.2: a filter shorter than the sample interval";
+    w << "floor power correlation at lag 1 is " << (r.size() > 1 ? r[1] : 0.0) << ", under "
+      << o.min_lag1_correlation << ": a filter shorter than the sample interval";
     return none(w.str());
   }
   if (static_cast<int>(r.size()) - 1 >= k_max) return none("floor correlation does not decay");
   // 5. The order and time constant whose rho_n^2 fits it best.
-  const double best = fitFilterShape(r, m, dt, &f);
+  const double best = fitFilterShape(r, m, dt, o, &f);
   f.found = true;
   f.source = "noise_floor";
   f.fit_rms = std::sqrt(best / f.n_lags);
-  // A floor stretch under 8 filter lengths (n T) gives an autocorrelation too noisy to trust.
-  if (m * dt < kMinFilterLengths * f.order * f.time_constant_s) {
+  // A floor stretch under min_filter_lengths filter lengths (n T) gives an autocorrelation too
+  // noisy to trust.
+  if (m * dt < o.min_filter_lengths * f.order * f.time_constant_s) {
     f.found = false;
-    return none("floor shorter than 8 filter lengths");
+    std::ostringstream w;
+    w << "floor shorter than " << o.min_filter_lengths << " filter lengths";
+    return none(w.str());
   }
   std::ostringstream w;
   w.precision(3);
@@ -327,15 +312,16 @@ std::vector<double> ringdownFilteredLogAmplitude(const std::string& law, const E
 RingdownFilteredFit fitRingdownThroughFilter(const RingdownEnvelope& env,
                                              const RingdownSegment& seg, const RingdownFit& law_fit,
                                              const RingdownDetectorFilter& filter,
-                                             const std::vector<double>& ar) {
+                                             const std::vector<double>& ar,
+                                             const RingdownFilteredFitOptions& o) {
   RingdownFilteredFit out;
   out.model = law_fit.model;
   if (!filter.found || law_fit.t_s.empty()) return out;
   const double ts = law_fit.t_scale_s, tr = law_fit.t_ref_s;
   const double tf = filter.time_constant_s / ts;
-  const double t_lo = seg.has_plateau
-                          ? seg.drive_off_s - 12.0 * filter.order * filter.time_constant_s
-                          : -std::numeric_limits<double>::infinity();
+  const double t_lo = seg.has_plateau ? seg.drive_off_s - o.lead_filter_lengths * filter.order *
+                                                              filter.time_constant_s
+                                      : -std::numeric_limits<double>::infinity();
   std::vector<double> tt, yy, ww;
   size_t j = 0;
   for (size_t i = 0; i < seg.i_end && i < env.size(); ++i) {
@@ -350,7 +336,7 @@ RingdownFilteredFit fitRingdownThroughFilter(const RingdownEnvelope& env,
   }
   const int n = static_cast<int>(tt.size());
   const int np = static_cast<int>(law_fit.p.size());
-  if (n < np + 10) return out;
+  if (n < np + o.min_extra_samples) return out;
   auto res = [&](const Eigen::VectorXd& q, Eigen::VectorXd& r) {
     const std::vector<double> f = ringdownFilteredLogAmplitude(
         law_fit.model, q.head(np), q(np), filter.order, tf, tt, law_fit.floor_rel);
@@ -366,7 +352,7 @@ RingdownFilteredFit fitRingdownThroughFilter(const RingdownEnvelope& env,
     q.head(np) = law_fit.p;
     q(np) = off0 + shift * filter.order * tf;
     double sse = 0.0;
-    if (!minimizeSumOfSquares(res, q, sse, 80)) continue;
+    if (!minimizeSumOfSquares(res, q, sse, o.max_iterations)) continue;
     if (sse < best) best = sse, out.p = q;
   }
   if (!std::isfinite(best)) return out;
