@@ -37,12 +37,12 @@ struct Grown {
 };
 
 /// Step 2 of the header from grid sample a; false when the first fall is not straight.
-bool grow(const std::vector<double>& u, const std::vector<double>& sm, size_t a, double first_db,
-          double tol, size_t run, Grown* g) {
+bool grow(const std::vector<double>& u, const std::vector<double>& sm, size_t a, double tol,
+          size_t run, const StraightSpanOptions& o, Grown* g) {
   const size_t m = u.size();
   size_t i1 = a;
-  while (i1 + 1 < m && sm[i1] > sm[a] - first_db) ++i1;
-  if (i1 < a + 6) return false;
+  while (i1 + 1 < m && sm[i1] > sm[a] - o.first_db) ++i1;
+  if (i1 < a + o.first_min_steps) return false;
   Eigen::Vector2d c = line(u, sm, a, i1);
   if (!(c(1) < 0.0)) return false;
   for (size_t i = a; i <= i1; ++i)
@@ -54,7 +54,8 @@ bool grow(const std::vector<double>& u, const std::vector<double>& sm, size_t a,
     } else {
       bad = 0;
       e = j;
-      if (e - refit >= std::max<size_t>(3, (e - a) / 10)) c = line(u, sm, a, e), refit = e;
+      if (e - refit >= std::max<size_t>(o.min_refit, (e - a) / o.refit_divisor))
+        c = line(u, sm, a, e), refit = e;
     }
   }
   g->a = a, g->e = e, g->j = std::min(j, m), g->c = line(u, sm, a, e);
@@ -80,7 +81,7 @@ StraightSpan findStraightSpan(const std::vector<double>& t, const std::vector<do
                               const std::vector<bool>& skip, const StraightSpanOptions& o) {
   StraightSpan out;
   const size_t n = y.size();
-  if (n < 16 || t.size() != n) return out;
+  if (n < o.min_points || t.size() != n) return out;
   // 1. Block medians (u: block centre time, raw: median level in dB, first[k]: first sample).
   const size_t stride = std::max<size_t>(1, (n + o.grid - 1) / o.grid);
   std::vector<double> u, raw;
@@ -96,17 +97,18 @@ StraightSpan findStraightSpan(const std::vector<double>& t, const std::vector<do
     u.push_back(tb / nb), raw.push_back(medianOf(b)), first.push_back(k);
   }
   const size_t m = u.size();
-  if (m < 16) return out;
+  if (m < o.min_points) return out;
   const std::vector<bool> none(m, false);
-  const std::vector<double> sm = runningMedian(raw, none, std::max<int>(2, m / 300));
+  const std::vector<double> sm =
+      runningMedian(raw, none, std::max<int>(o.min_smooth_half, m / o.smooth_divisor));
   std::vector<double> d;
   for (size_t i = 1; i < m; ++i) d.push_back(std::fabs(raw[i] - raw[i - 1]));
   const double sd = kGaussianSdPerMad * medianOf(d) / std::sqrt(2.0);
-  const double tol = std::max(o.tol_db, 4.0 * sd);
-  const size_t run = std::max<size_t>(3, m / 100);
+  const double tol = std::max(o.tol_db, o.tol_sd * sd);
+  const size_t run = std::max<size_t>(o.min_run, m / o.run_divisor);
   // The peak from a wider median (2 % of the grid), so that a glitch of a few samples is none.
   // Its last `hw` samples are left out (a clipped window there is a median of a few).
-  const size_t hw = std::max<size_t>(3, m / 50);
+  const size_t hw = std::max<size_t>(o.min_peak_median_half, m / o.peak_median_divisor);
   const std::vector<double> wide = runningMedian(raw, none, static_cast<int>(hw));
   size_t ip = 0;
   for (size_t i = 1; i + hw < m; ++i)
@@ -125,15 +127,15 @@ StraightSpan findStraightSpan(const std::vector<double>& t, const std::vector<do
   Grown best;
   double best_db = 0.0, best_score = 0.0;
   for (const size_t pk : peaks)
-    for (const double drop : {1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 17.0, 23.0, 30.0, 40.0}) {
+    for (const double drop : o.start_drops_db) {
       size_t a = pk;
       while (a + 1 < m && sm[a] > sm[pk] - drop) ++a;
-      if (a + 7 >= m) break;
+      if (a + o.first_min_steps + 1 >= m) break;
       Grown g;
-      if (!grow(u, sm, a, o.first_db, tol, run, &g)) continue;
+      if (!grow(u, sm, a, tol, run, o, &g)) continue;
       const double span_db = -g.c(1) * (u[g.e] - u[g.a]);
       const double score = span_db * std::sqrt(double(g.e - g.a + 1));
-      if (!found || score > 1.05 * best_score)
+      if (!found || score > o.tie_ratio * best_score)
         found = true, best = g, best_db = span_db, best_score = score;
     }
   if (!found) return out;
@@ -142,10 +144,10 @@ StraightSpan findStraightSpan(const std::vector<double>& t, const std::vector<do
   out.i_end = best.e + 1 < m ? first[best.e + 1] : n;
   out.slope_db_s = best.c(1);
   out.span_db = best_db;
-  // 4. How it ends: the level's slope past the end, over 30 % of the stretch (at least `run`
-  // grid samples), against the stretch's own.
+  // 4. How it ends: the level's slope past the end, over post_tenths tenths of the stretch (at
+  // least `run` grid samples), against the stretch's own.
   if (best.j >= m) return out;
-  const size_t len = std::max<size_t>(run, (best.e - best.a) * 3 / 10);
+  const size_t len = std::max<size_t>(run, (best.e - best.a) * o.post_tenths / 10);
   const size_t p_end = std::min(m - 1, best.e + len);
   double past_mean = 0.0;
   for (size_t i = best.e + 1; i <= std::min(m - 1, best.e + run); ++i)
