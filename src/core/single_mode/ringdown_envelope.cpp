@@ -10,7 +10,8 @@
 
 namespace cvg_bench {
 
-RingdownEnvelope ringdownEnvelope(const RingdownRecord& record, double frequency_hz) {
+RingdownEnvelope ringdownEnvelope(const RingdownRecord& record, double frequency_hz,
+                                  const RingdownEnvelopeOptions& options) {
   RingdownEnvelope env;
   env.frequency_hz = frequency_hz > 0.0 ? frequency_hz : record.frequency_hz;
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -52,7 +53,9 @@ RingdownEnvelope ringdownEnvelope(const RingdownRecord& record, double frequency
   o.omega_rad_s = omega;
   o.sample_rate_hz = 1.0 / sampling.median_interval_s;
   // Slow rate: well below the carrier, fast enough for the decay (default 100 Hz, capped).
-  o.output_rate_hz = std::min(100.0, std::min(o.sample_rate_hz / 8.0, omega / (2.0 * M_PI) / 4.0));
+  o.output_rate_hz = std::min(options.max_output_rate_hz,
+                              std::min(o.sample_rate_hz / options.min_decimation,
+                                       omega / (2.0 * M_PI) / options.carrier_divisor));
   const SlowRecord slow = demodulateUniform(raw, o);
   env.t_s = slow.t_s;
   env.log_amplitude.resize(slow.size());

@@ -20,8 +20,23 @@ struct RingdownEnvelope {
   size_t size() const { return t_s.size(); }
 };
 
+/// The envelope rate of a raw waveform: min(max_output_rate_hz, sample rate /
+/// min_decimation, mode frequency / carrier_divisor). All three set by hand with the ring-downs
+/// (commit 3dbfdf5), no recorded evidence; the demodulator itself needs the rate under twice the
+/// mode frequency (its mixing image) and the sample rate.
+struct RingdownEnvelopeOptions {
+  /// The envelope's sample rate at most [Hz]: "fast enough for the decay" (the demodulator's
+  /// default output rate).
+  double max_output_rate_hz = 100.0;
+  /// The sample rate over the envelope rate at least [-].
+  double min_decimation = 8.0;
+  /// The mode frequency over the envelope rate at least [-]: "well below the carrier".
+  double carrier_divisor = 4.0;
+};
+
 /// frequency_hz > 0 overrides the record's; a raw waveform without any frequency has its
 /// frequency estimated (frequency_estimator.h) and the notes say so.
-RingdownEnvelope ringdownEnvelope(const RingdownRecord& record, double frequency_hz = 0.0);
+RingdownEnvelope ringdownEnvelope(const RingdownRecord& record, double frequency_hz = 0.0,
+                                  const RingdownEnvelopeOptions& options = {});
 
 }  // namespace cvg_bench
