@@ -8,12 +8,14 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <stdexcept>
 
 #include "cli_args.h"
 #include "cvg_bench/core/io/response_record.h"
 #include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/response_simulator.h"
 #include "cvg_bench/core/single_mode/response_explain.h"
+#include "cvg_bench/core/single_mode/response_laws.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_bench/report/response_json.h"
 #include "cvg_ident_commands.h"
@@ -60,6 +62,23 @@ const char* kSimulateHelp =
     "(x'' + 2 pi w(x) x' + (2 pi f0)^2 x + k3 x^3 = F cos(2 pi f t)) and demodulated; the truth\n"
     "goes to '#' lines (f0_hz, width_hz, Q, backbone_hz_per_amp2, width_growth_hz_per_amp2).\n";
 
+/// The generator's coefficient of a term (its options name them like ResponseParams).
+double& effectOf(ResponseSimulatorOptions& o, const ResponseLaw& law) {
+  if (law.coefficient == &ResponseParams::backbone_hz_per_amp2) return o.backbone_hz_per_amp2;
+  if (law.coefficient == &ResponseParams::width_growth_hz_per_amp2)
+    return o.width_growth_hz_per_amp2;
+  throw std::logic_error(std::string("--effect ") + law.name + ": the generator has no such term");
+}
+
+/// The terms' names as --effect's message lists them: "a, b and c".
+std::string effectNames() {
+  const std::vector<ResponseLaw>& laws = responseLaws();
+  std::string s;
+  for (size_t i = 0; i < laws.size(); ++i)
+    s += (i == 0 ? "" : i + 1 == laws.size() ? " and " : ", ") + std::string(laws[i].name);
+  return s;
+}
+
 ResponseRecord readInput(const CliArgs& args, std::vector<std::string>& notes) {
   if (args.positionals().size() != 1) throw InputError("exactly one INPUT file is needed");
   ResponseRecord r = readResponseFile(args.positionals().front(), args.get("columns"));
@@ -80,8 +99,11 @@ void printFit(const ResponseFit& f, std::ostream& os) {
      << " sweeps, " << f.n_drive_levels << " drive levels, response " << responseKindName(f.kind)
      << "\n";
   char buf[200];
-  for (const char* k : {"f0_hz", "width_hz", "Q", "backbone_hz_per_amp2",
-                        "width_growth_hz_per_amp2", "gamma_nl_term"}) {
+  std::vector<const char*> keys = {"f0_hz", "width_hz", "Q"};
+  for (const ResponseLaw& law : responseLaws()) keys.push_back(law.derived_key);
+  for (const ResponseLaw& law : responseLaws())
+    if (law.model_term_key) keys.push_back(law.model_term_key);
+  for (const char* k : keys) {
     const auto it = f.derived.find(k);
     if (it == f.derived.end()) continue;
     if (std::find(f.not_determined.begin(), f.not_determined.end(), k) != f.not_determined.end()) {
@@ -134,7 +156,7 @@ int runResponseIdentify(const std::vector<std::string>& argv) {
   o.kind = kindOf(args, notes);
   o.confidence = args.getDouble("confidence", 0.95);
   if (!(o.confidence > 0 && o.confidence < 1)) throw InputError("--confidence must lie in (0, 1)");
-  const ResponseTerms terms = parseResponseTerms(args.get("model", "linear"));
+  const ResponseTerms terms = parseResponseTerms(args.get("model", kLinearResponseModel));
   const ResponseFit fit = fitResponse(responseDataOf(rec, o.kind), terms, o);
   for (const auto& n : notes) std::cout << "note: " << n << "\n";
   printFit(fit, std::cout);
@@ -232,12 +254,9 @@ int runResponseSimulate(const std::vector<std::string>& argv) {
     const std::string k = e.substr(0, eq);
     const double v = eq == std::string::npos ? NAN : std::atof(e.c_str() + eq + 1);
     if (!std::isfinite(v)) throw InputError("--effect " + e + ": give NAME=VALUE");
-    if (k == "xi")
-      o.backbone_hz_per_amp2 = v;
-    else if (k == "gamma_nl")
-      o.width_growth_hz_per_amp2 = v;
-    else
-      throw InputError("--effect " + k + ": one-mode effects are xi and gamma_nl");
+    const ResponseLaw* law = findResponseLaw(k);
+    if (!law) throw InputError("--effect " + k + ": one-mode effects are " + effectNames());
+    effectOf(o, *law) = v;
   }
   const ResponseRecord rec = simulateResponse(o);
   std::ofstream out(args.get("out"));

@@ -6,16 +6,15 @@
 #include <cmath>
 #include <cstdio>
 
+#include "cvg_bench/core/single_mode/response_laws.h"
+
 namespace cvg_bench {
 namespace {
 
-const char* const kTermKey[] = {"backbone_hz_per_amp2", "width_growth_hz_per_amp2"};
-const char* const kTermName[] = {"xi", "gamma_nl"};
-
 /// Two-sided p of a term from its interval's t (value / std, the fit's dof); 1 when the data
 /// cannot determine it.
-double termP(const ResponseFit& f, int term) {
-  const std::string key = kTermKey[term];
+double termP(const ResponseFit& f, const ResponseLaw& law) {
+  const std::string key = law.derived_key;
   if (std::find(f.not_determined.begin(), f.not_determined.end(), key) != f.not_determined.end())
     return 1.0;
   const auto it = f.derived.find(key);
@@ -24,6 +23,28 @@ double termP(const ResponseFit& f, int term) {
   if (!std::isfinite(t)) return 1.0;
   boost::math::students_t dist(std::max(1, it->second.dof > 0 ? it->second.dof : f.interval_dof));
   return 2.0 * boost::math::cdf(boost::math::complement(dist, t));
+}
+
+/// The model with the most terms of those whose every term passes; among as many terms, the one
+/// whose largest p is smallest (the earlier on a tie); linear (0) when none passes. With two terms:
+/// the joint model when both pass there, else the passing single term with the smaller p.
+size_t selectCandidate(const std::vector<ResponseCandidate>& candidates) {
+  size_t pick = 0;
+  int pick_terms = 0;
+  double pick_p = 0.0;
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const ResponseCandidate& c = candidates[i];
+    if (!c.significant) continue;
+    const int terms = responseTermCount(c.fit.terms);
+    double p = 0.0;
+    for (const auto& kv : c.p_values) p = std::max(p, kv.second);
+    if (terms > pick_terms || (terms == pick_terms && p < pick_p)) {
+      pick = i;
+      pick_terms = terms;
+      pick_p = p;
+    }
+  }
+  return pick;
 }
 
 std::string fmt(const char* f, double v) {
@@ -36,9 +57,7 @@ std::string fmt(const char* f, double v) {
 
 ResponseExplanation explainResponse(const ResponseData& data, const ResponseExplainOptions& o) {
   ResponseExplanation x;
-  const ResponseTerms kinds[4] = {
-      {false, false, false}, {true, false, false}, {false, true, false}, {true, true, false}};
-  for (const ResponseTerms& t : kinds) {
+  for (const ResponseTerms& t : responseTermCombinations()) {
     ResponseCandidate c;
     ResponseFitOptions fo = o.fit;
     fo.level_gain_check = true;
@@ -47,32 +66,19 @@ ResponseExplanation explainResponse(const ResponseData& data, const ResponseExpl
     bool all = true;
     const double u_max = c.fit.u.empty() ? 0.0 : *std::max_element(c.fit.u.begin(), c.fit.u.end());
     const double w = c.fit.derived.at("width_hz").value;
-    for (int term = 0; term < 2; ++term) {
-      if (!(term == 0 ? t.backbone : t.width_growth)) continue;
-      const double p = termP(c.fit, term);
-      const double effect = std::abs(c.fit.derived.at(kTermKey[term]).value) * u_max / w;
-      c.p_values[kTermName[term]] = p;
-      c.effect_over_width[kTermName[term]] = effect;
+    for (const ResponseLaw& law : responseLaws()) {
+      if (!(t.*law.flag)) continue;
+      const double p = termP(c.fit, law);
+      const double effect = std::abs(c.fit.derived.at(law.derived_key).value) * u_max / w;
+      c.p_values[law.name] = p;
+      c.effect_over_width[law.name] = effect;
       all = all && p < o.alpha && effect >= o.min_effect_over_width;
     }
-    c.significant = all && (t.backbone || t.width_growth);
+    c.significant = all && responseTermCount(t) > 0;
     x.candidates.push_back(c);
   }
-  // Joint model when both terms pass there; else the passing single term with the smaller p.
-  size_t pick = 0;
-  if (x.candidates[3].significant) {
-    pick = 3;
-  } else {
-    const bool s1 = x.candidates[1].significant, s2 = x.candidates[2].significant;
-    if (s1 && s2)
-      pick = x.candidates[1].p_values["xi"] <= x.candidates[2].p_values["gamma_nl"] ? 1 : 2;
-    else if (s1)
-      pick = 1;
-    else if (s2)
-      pick = 2;
-  }
-  x.selected_index = pick;
-  const ResponseFit& sel = x.candidates[pick].fit;
+  x.selected_index = selectCandidate(x.candidates);
+  const ResponseFit& sel = x.candidates[x.selected_index].fit;
   if (o.fit.require_resonance && o.fit.intervals) requireResponseResonance(sel);
   x.selected = sel.terms.name();
   // Adequacy against free Lorentzians per drive level.
@@ -95,17 +101,14 @@ ResponseExplanation explainResponse(const ResponseData& data, const ResponseExpl
                         "of the model follows (RSS " +
                             fmt("%.3g", x.adequacy_ratio) +
                             "x that with a free drive factor per level); best model " + x.selected
-                  : x.selected == "linear" ? "linear"
-                                           : x.selected;
+                      : x.selected;
   auto d = [&](const char* k) { return sel.derived.at(k).value; };
   v += "; f0 " + fmt("%.8g", d("f0_hz")) + " Hz, width " + fmt("%.4g", d("width_hz")) + " Hz, Q " +
        fmt("%.4g", d("Q"));
-  if (sel.terms.backbone)
-    v += std::string("; ") + (d("backbone_hz_per_amp2") < 0 ? "softening" : "hardening") +
-         " backbone " + fmt("%.4g", d("backbone_hz_per_amp2")) + " Hz/amp^2";
-  if (sel.terms.width_growth)
-    v += std::string("; width ") + (d("width_growth_hz_per_amp2") > 0 ? "grows" : "falls") +
-         " with amplitude " + fmt("%.4g", d("width_growth_hz_per_amp2")) + " Hz/amp^2";
+  for (const ResponseLaw& law : responseLaws())
+    if (sel.terms.*law.flag)
+      v += std::string("; ") + law.verdict_words(d(law.derived_key)) + " " +
+           fmt("%.4g", d(law.derived_key)) + " " + law.unit;
   if (sel.jumps > 0) v += "; " + std::to_string(sel.jumps) + " jumps reproduced by the branch";
   x.verdict = v;
   return x;

@@ -13,7 +13,7 @@
 #include "cvg_bench/core/estimate/dense_solver_options.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/model/gamma_nl_conventions.h"
+#include "cvg_bench/core/single_mode/response_laws.h"
 
 namespace cvg_bench {
 namespace {
@@ -59,10 +59,14 @@ constexpr int kJackknifeRefitIterations = 100;
 /// Gaussian kurtosis: 3 (sum d^2)^2 / sum d^4 is the effective number of deviations d.
 constexpr double kGaussianKurtosis = 3.0;
 
-/// Parameter vector: f0, w0, Re a, Im a, Re b0, Im b0, [Re b1, Im b1], [xi], [g].
+/// Parameter vector: f0, w0, Re a, Im a, Re b0, Im b0, [Re b1, Im b1], then the nonlinear terms'
+/// coefficients in the registry's order (response_laws.h): [xi], [g].
 struct Layout {
-  bool slope = false, xi = false, g = false;
-  int size() const { return 6 + (slope ? 2 : 0) + (xi ? 1 : 0) + (g ? 1 : 0); }
+  bool slope = false;
+  ResponseTerms terms;  ///< the nonlinear terms (its background_slope is not read: `slope`)
+  bool has(const ResponseLaw& law) const { return terms.*law.flag; }
+  bool nonlinear() const { return responseTermCount(terms) > 0; }
+  int size() const { return 6 + (slope ? 2 : 0) + responseTermCount(terms); }
 };
 
 ResponseParams unpack(const double* x, const Layout& L, double f_ref) {
@@ -76,8 +80,8 @@ ResponseParams unpack(const double* x, const Layout& L, double f_ref) {
     p.bg1 = cd(x[k], x[k + 1]);
     k += 2;
   }
-  if (L.xi) p.backbone_hz_per_amp2 = x[k++];
-  if (L.g) p.width_growth_hz_per_amp2 = x[k++];
+  for (const ResponseLaw& law : responseLaws())
+    if (L.has(law)) p.*law.coefficient = x[k++];
   p.f_ref_hz = f_ref;
   return p;
 }
@@ -89,8 +93,8 @@ std::vector<double> pack(const ResponseParams& p, const Layout& L) {
     x.push_back(p.bg1.real());
     x.push_back(p.bg1.imag());
   }
-  if (L.xi) x.push_back(p.backbone_hz_per_amp2);
-  if (L.g) x.push_back(p.width_growth_hz_per_amp2);
+  for (const ResponseLaw& law : responseLaws())
+    if (L.has(law)) x.push_back(p.*law.coefficient);
   return x;
 }
 
@@ -296,8 +300,8 @@ double lag1Along(const ResponseData& d, const std::vector<cd>& m) {
 std::map<std::string, double> derivedOf(const ResponseParams& p, const Layout& L, double u_scale) {
   std::map<std::string, double> v = {
       {"f0_hz", p.f0_hz}, {"width_hz", p.width_hz}, {"Q", p.f0_hz / p.width_hz}};
-  if (L.xi) v["backbone_hz_per_amp2"] = p.backbone_hz_per_amp2 / u_scale;
-  if (L.g) v["width_growth_hz_per_amp2"] = p.width_growth_hz_per_amp2 / u_scale;
+  for (const ResponseLaw& law : responseLaws())
+    if (L.has(law)) v[law.derived_key] = p.*law.coefficient / u_scale;
   return v;
 }
 
@@ -410,8 +414,7 @@ void chooseLayout(const ResponseTerms& terms, FitContext* c, ResponseParams* lin
                   ResponseFit* fit) {
   const ResponseData& d = c->d;
   Layout& L = c->L;
-  L.xi = terms.backbone;
-  L.g = terms.width_growth;
+  for (const ResponseLaw& law : responseLaws()) L.terms.*law.flag = terms.*law.flag;
   {
     ResponseParams no_slope;
     const double rss0 = gridLinear(d, c->all, false, c->f_ref, &no_slope);
@@ -480,7 +483,7 @@ std::vector<ResponseParams> startsOf(const FitContext& c, const ResponseParams& 
                                      const std::vector<ResponseLevelFit>& levels) {
   const Layout& L = c.L;
   std::vector<ResponseParams> starts = {lin};
-  if ((L.xi || L.g) && levels.size() >= 2) {
+  if (L.nonlinear() && levels.size() >= 2) {
     double su = 0, sf = 0, sw = 0, suu = 0, suf = 0, suw = 0;
     const double m = static_cast<double>(levels.size());
     for (const auto& lf : levels) {
@@ -498,10 +501,10 @@ std::vector<ResponseParams> startsOf(const FitContext& c, const ResponseParams& 
       s.f0_hz = (sf - xi * su) / m;
       s.width_hz = std::max((sw - g * su) / m, kMinStartWidthFraction * levels.front().width_hz);
       projectLinear(c.d, c.all, s.f0_hz, s.width_hz, L.slope, c.f_ref, &s);
-      if (L.xi) s.backbone_hz_per_amp2 = xi;
-      if (L.g) s.width_growth_hz_per_amp2 = g;
+      if (L.terms.backbone) s.backbone_hz_per_amp2 = xi;
+      if (L.terms.width_growth) s.width_growth_hz_per_amp2 = g;
       starts.push_back(s);
-      if (L.xi) {  // the same trend read as a backbone of the other sign
+      if (L.terms.backbone) {  // the same trend read as a backbone of the other sign
         ResponseParams t = s;
         t.backbone_hz_per_amp2 = -xi;
         starts.push_back(t);
@@ -587,13 +590,13 @@ BestFit refineStarts(const FitContext& c, const std::vector<ResponseParams>& sta
   double delta = delta_compare;
   for (const ResponseParams& s : starts) {
     std::vector<ResponseParams> tries = {s};
-    if (L.xi || L.g) {
+    if (L.nonlinear()) {
       bool ok_smooth = false;
       double unused = 0.0;
       const ResponseParams sm = rr.robustRefine(s, BranchChoice::kNearestData, &ok_smooth, &unused);
       if (ok_smooth) tries.push_back(sm);
     }
-    if (L.xi || L.g) {  // and the noise's threshold from the start (a fold's point clipped)
+    if (L.nonlinear()) {  // and the noise's threshold from the start (a fold's point clipped)
       bool ok_fixed = false;
       const ResponseParams sf = refine(d, L, s, kRobustFitIterations, &ok_fixed,
                                        BranchChoice::kNearestData, delta_compare);
@@ -602,7 +605,7 @@ BestFit refineStarts(const FitContext& c, const std::vector<ResponseParams>& sta
     for (size_t k = 0; k < tries.size(); ++k) {
       bool ok = false;
       double used = delta_compare;
-      const ResponseParams p = k + 1 == tries.size() && (L.xi || L.g)
+      const ResponseParams p = k + 1 == tries.size() && L.nonlinear()
                                    ? refine(d, L, tries[k], kRobustFitIterations, &ok,
                                             BranchChoice::kFollow, delta_compare)
                                    : rr.robustRefine(tries[k], BranchChoice::kFollow, &ok, &used);
@@ -703,8 +706,8 @@ void markNotDetermined(const Layout& L, const ScaledJacobian& sj, const Response
     if (weak[0]) weak_derived.push_back("f0_hz");
     if (weak[1]) weak_derived.push_back("width_hz");
     if (weak[0] || weak[1]) weak_derived.push_back("Q");
-    if (L.xi && weak[k++]) weak_derived.push_back("backbone_hz_per_amp2");
-    if (L.g && weak[k]) weak_derived.push_back("width_growth_hz_per_amp2");
+    for (const ResponseLaw& law : responseLaws())
+      if (L.has(law) && weak[k++]) weak_derived.push_back(law.derived_key);
     for (int j = 2; j < 6; ++j)
       if (weak[j]) fit->notes.push_back(std::string(kParamNames[j]) + " is not determined");
   }
@@ -774,15 +777,11 @@ std::map<std::string, double> sandwichStd(const FitContext& c, const ResponsePar
   sandwich_std["width_hz"] = sd(g1);
   sandwich_std["Q"] = sd(gq);
   int k = 6 + (L.slope ? 2 : 0);
-  if (L.xi) {
-    Eigen::VectorXd gx = Eigen::VectorXd::Zero(L.size());
-    gx(k++) = 1.0 / (zs * zs);
-    sandwich_std["backbone_hz_per_amp2"] = sd(gx);
-  }
-  if (L.g) {
-    Eigen::VectorXd gg = Eigen::VectorXd::Zero(L.size());
-    gg(k) = 1.0 / (zs * zs);
-    sandwich_std["width_growth_hz_per_amp2"] = sd(gg);
+  for (const ResponseLaw& law : responseLaws()) {
+    if (!L.has(law)) continue;
+    Eigen::VectorXd gt = Eigen::VectorXd::Zero(L.size());
+    gt(k++) = 1.0 / (zs * zs);
+    sandwich_std[law.derived_key] = sd(gt);
   }
   return sandwich_std;
 }
@@ -817,7 +816,7 @@ std::map<std::string, std::vector<double>> leaveOneSweepOut(const FitContext& c,
     // The smooth stage first (continuous in the data), then the branch followed again.
     bool ok_smooth = false, ok = false;
     ResponseParams pg = best;
-    if (L.xi || L.g) {
+    if (L.nonlinear()) {
       const ResponseParams ps = refine(dg, L, best, kJackknifeRefitIterations, &ok_smooth,
                                        BranchChoice::kNearestData, delta);
       if (ok_smooth) pg = ps;
@@ -848,7 +847,7 @@ void jackknifeOverSweeps(const FitContext& c, const ResponseParams& best, double
   // model has no fold; there its sandwich, linearised once with unweighted bread under Huber
   // weights, can exceed the refits' spread many times (the low half of the wire record
   // example6: width sd 4.7 Hz against leave-one-out deviations of 0.05 Hz) and is not used.
-  const bool folds_possible = L.xi || L.g;
+  const bool folds_possible = L.nonlinear();
   int min_dof = fit->interval_dof, floored = 0;
   for (auto& kv : reps) {
     const auto& v = kv.second;
@@ -894,16 +893,19 @@ void setIntervals(const ResponseFitOptions& o, ResponseFit* fit) {
   }
 }
 
-/// Step 16. The model term's coefficient (gamma_nl_conventions.h): 8 pi times the width growth.
-void addGammaNlTerm(ResponseFit* fit) {
-  const auto g = fit->derived.find("width_growth_hz_per_amp2");
-  if (g != fit->derived.end()) {
+/// Step 16. The model term's coefficient of each term that has one (response_laws.h,
+/// gamma_nl_conventions.h: gamma_nl_term = 8 pi times the width growth).
+void addModelTerms(ResponseFit* fit) {
+  for (const ResponseLaw& law : responseLaws()) {
+    if (!law.model_term_key) continue;
+    const auto g = fit->derived.find(law.derived_key);
+    if (g == fit->derived.end()) continue;
     ResponseValue t = g->second;
-    for (double* v : {&t.value, &t.std, &t.ci_low, &t.ci_high}) *v *= kGammaNlTermPerWidthGrowthHz;
-    fit->derived["gamma_nl_term"] = t;
+    for (double* v : {&t.value, &t.std, &t.ci_low, &t.ci_high}) *v *= law.model_term_per_unit;
+    fit->derived[law.model_term_key] = t;
     if (std::find(fit->not_determined.begin(), fit->not_determined.end(), g->first) !=
         fit->not_determined.end())
-      fit->not_determined.push_back("gamma_nl_term");
+      fit->not_determined.push_back(law.model_term_key);
   }
 }
 
@@ -965,7 +967,7 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   if (G >= o.min_sweeps_for_jackknife) jackknifeOverSweeps(c, best, delta, G, sandwich_std, &fit);
   setIntervals(o, &fit);
   if (o.require_resonance) requireResponseResonance(fit);
-  addGammaNlTerm(&fit);
+  addModelTerms(&fit);
   return fit;
 }
 

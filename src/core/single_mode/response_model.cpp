@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/single_mode/response_laws.h"
 
 namespace cvg_bench {
 namespace {
@@ -44,27 +45,27 @@ std::complex<double> shapeOf(const ResponseParams& p, ResponseKind kind, double 
 }  // namespace
 
 std::string ResponseTerms::name() const {
-  if (backbone && width_growth) return "xi+gamma_nl";
-  if (backbone) return "xi";
-  if (width_growth) return "gamma_nl";
-  return "linear";
+  std::string s;
+  for (const ResponseLaw& law : responseLaws())
+    if (this->*law.flag) s += (s.empty() ? "" : "+") + std::string(law.name);
+  return s.empty() ? kLinearResponseModel : s;
 }
 
 ResponseTerms parseResponseTerms(const std::string& model) {
   ResponseTerms t;
-  if (model == "linear") return t;
+  if (model == kLinearResponseModel) return t;
   std::stringstream ss(model);
   std::string item;
   while (std::getline(ss, item, '+')) {
-    if (item == "xi") {
-      t.backbone = true;
-    } else if (item == "gamma_nl") {
-      t.width_growth = true;
-    } else {
-      throw InputError("--model: '" + item +
-                       "' is not a one-mode term (--mode response: linear, xi, gamma_nl, "
-                       "xi+gamma_nl; two-mode terms such as xi_diff or mu need two modes)");
+    const ResponseLaw* law = findResponseLaw(item);
+    if (!law) {
+      std::string known;
+      for (const ResponseTerms& c : responseTermCombinations())
+        known += (known.empty() ? "" : ", ") + c.name();
+      throw InputError("--model: '" + item + "' is not a one-mode term (--mode response: " + known +
+                       "; two-mode terms such as xi_diff or mu need two modes)");
     }
+    t.*law->flag = true;
   }
   return t;
 }

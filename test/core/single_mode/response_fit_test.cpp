@@ -6,6 +6,7 @@
 
 #include "cvg_bench/core/simulate/response_simulator.h"
 #include "cvg_bench/core/single_mode/response_explain.h"
+#include "cvg_bench/core/single_mode/response_laws.h"
 
 namespace cvg_bench {
 namespace {
@@ -81,6 +82,22 @@ TEST(ResponseExplain, SelectsTheTermTheRecordHas) {
     const ResponseExplanation x = explainResponse(responseDataOf(r, xo.fit.kind), xo);
     EXPECT_EQ(x.selected, "linear");
     EXPECT_FALSE(x.unexplained) << x.adequacy_ratio;
+    // Every combination of the registry's terms is a candidate, with its terms' keys and p values.
+    const std::vector<ResponseTerms> all = responseTermCombinations();
+    ASSERT_EQ(x.candidates.size(), all.size());
+    for (size_t i = 0; i < all.size(); ++i) {
+      const ResponseCandidate& c = x.candidates[i];
+      EXPECT_EQ(c.fit.terms.name(), all[i].name());
+      for (const ResponseLaw& law : responseLaws()) {
+        const bool has = all[i].*law.flag;
+        EXPECT_EQ(c.fit.derived.count(law.derived_key), has ? 1u : 0u) << c.fit.terms.name();
+        EXPECT_EQ(c.p_values.count(law.name), has ? 1u : 0u) << c.fit.terms.name();
+        EXPECT_EQ(c.effect_over_width.count(law.name), has ? 1u : 0u) << c.fit.terms.name();
+        if (law.model_term_key) {
+          EXPECT_EQ(c.fit.derived.count(law.model_term_key), has ? 1u : 0u) << law.model_term_key;
+        }
+      }
+    }
   }
   {
     ResponseSimulatorOptions o = base(22);

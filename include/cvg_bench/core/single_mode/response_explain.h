@@ -30,12 +30,13 @@ struct ResponseExplainOptions {
 struct ResponseCandidate {
   ResponseFit fit;
   bool significant = false;                         ///< every term of the candidate passes its test
-  std::map<std::string, double> p_values;           ///< per term ("xi", "gamma_nl")
+  std::map<std::string, double> p_values;           ///< per term name (response_laws.h)
   std::map<std::string, double> effect_over_width;  ///< per term, at the largest amplitude
 };
 
 struct ResponseExplanation {
-  std::vector<ResponseCandidate> candidates;  ///< linear, xi, gamma_nl, xi+gamma_nl
+  /// responseTermCombinations() in its order: linear, xi, gamma_nl, xi+gamma_nl
+  std::vector<ResponseCandidate> candidates;
   std::string selected;
   size_t selected_index = 0;
   bool unexplained = false;

@@ -27,14 +27,17 @@
 
 namespace cvg_bench {
 
-/// Which terms a one-mode model has: `xi` (backbone), `gamma_nl` (width growth), background slope.
+/// Which terms a one-mode model has: backbone (xi), width growth (gamma_nl), background slope. The
+/// terms' names, keys and texts are in the registry response_laws.h.
 struct ResponseTerms {
   bool backbone = false;
   bool width_growth = false;
   bool background_slope = false;
-  std::string name() const;  ///< "linear", "xi", "gamma_nl", "xi+gamma_nl"
+  /// `linear`, or the terms' names joined by '+' in the registry's order (xi+gamma_nl).
+  std::string name() const;
 };
-/// "linear", "xi", "gamma_nl", "xi+gamma_nl" (either order); InputError on other names.
+/// `linear`, or term names of the registry (response_laws.h) joined by '+' in any order; InputError
+/// on other names.
 ResponseTerms parseResponseTerms(const std::string& model);
 
 struct ResponseParams {
