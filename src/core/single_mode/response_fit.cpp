@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 
@@ -20,44 +21,29 @@ namespace {
 
 using cd = std::complex<double>;
 
-/// Largest lag-1 residual correlation the background-slope F test deflates its dof by.
-constexpr double kMaxSlopeTestLag1 = 0.95;
-/// Smallest dof the background-slope F test's denominator is given.
-constexpr double kMinSlopeTestDof = 4.0;
+// The fit's tuned thresholds are ResponseFitOptions' fields; what stays here is definitional.
+
 /// Real parameters of the linear model with a background slope (f0, w, gain, bg0, bg1).
 constexpr double kSlopeModelParams = 8.0;
-/// F above which a background slope is fitted: ~p < 1e-6 for F(2, dof large).
-constexpr double kSlopeTestF = 15.0;
-/// Fewest points of a drive level for its own Lorentzian fit.
-constexpr size_t kMinLevelPoints = 8;
-/// Levenberg-Marquardt iterations of a drive level's own Lorentzian fit.
-constexpr int kLevelFitIterations = 200;
-/// The trend start's width at least this fraction of the first level's width.
-constexpr double kMinStartWidthFraction = 0.2;
-/// Median of |e| / sigma for complex Gaussian noise of sigma per component (sqrt(2 ln 2), rounded).
+/// Median of |e| / sigma for complex Gaussian noise of sigma per component: |e| is Rayleigh,
+/// median sigma sqrt(2 ln 2) = 1.17741 sigma (rounded).
 constexpr double kMedianAbsPerSigma = 1.1774;
-/// Fewest free per-level residuals whose median is taken as a noise scale.
-constexpr size_t kMinResidualsForNoise = 8;
-/// Huber threshold in noise scales (a stage's: of the larger of noise and median misfit/1.1774).
-constexpr double kHuberNoiseScales = 3.0;
-/// Most Huber rounds of a robust refinement (the threshold following the misfit).
-constexpr int kMaxHuberRounds = 4;
-/// Levenberg-Marquardt iterations of each refinement of a start.
-constexpr int kRobustFitIterations = 300;
-/// Another Huber round only while the threshold falls below this fraction of the last.
-constexpr double kHuberShrinkForAnotherRound = 0.8;
-/// A direction is not determined below rank_tolerance times this relative singular value.
-constexpr double kWeakDirectionToleranceFactor = 1e3;
-/// A parameter takes part in a weak direction when its component in it exceeds this.
-constexpr double kWeakDirectionLoading = 0.3;
-/// Bartlett bandwidth within a sweep of m points: scale (m / points)^exponent point lags.
+/// Bartlett bandwidth within a sweep of m points: scale (m / points)^exponent point lags, rounded
+/// up. The published rule 4 (m/100)^(2/9) of Newey and West (1994, Rev. Econ. Stud. 61, 631-653:
+/// their pilot lag for the Bartlett kernel, commonly used as the lag itself), not a value tuned
+/// here, so it stays a constant.
 constexpr double kBartlettBandwidthScale = 4.0;
 constexpr double kBartlettBandwidthPoints = 100.0;
 constexpr double kBartlettBandwidthExponent = 2.0 / 9.0;
-/// Levenberg-Marquardt iterations of each jackknife refit.
-constexpr int kJackknifeRefitIterations = 100;
 /// Gaussian kurtosis: 3 (sum d^2)^2 / sum d^4 is the effective number of deviations d.
 constexpr double kGaussianKurtosis = 3.0;
+
+/// `v` as printf's %g (the notes' numbers of options).
+std::string fmtG(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", v);
+  return buf;
+}
 
 /// Parameter vector: f0, w0, Re a, Im a, Re b0, Im b0, [Re b1, Im b1], then the nonlinear terms'
 /// coefficients in the registry's order (response_laws.h): [xi], [g].
@@ -151,7 +137,8 @@ struct ScaledDriveError {
 
 /// RSS of the model refitted with a free drive factor per level (from `start`, factors 1).
 double rssWithFreeDriveScales(const ResponseData& d, const Layout& L, const ResponseParams& start,
-                              const std::vector<int>& level, int n_levels, double huber_delta) {
+                              const std::vector<int>& level, int n_levels, double huber_delta,
+                              int max_iterations) {
   std::vector<double> x = pack(start, L), s(n_levels - 1, 0.0);
   auto* cost = new ceres::DynamicNumericDiffCostFunction<ScaledDriveError, ceres::CENTRAL>(
       new ScaledDriveError{&d, L, start.f_ref_hz, level, huber_delta});
@@ -161,7 +148,7 @@ double rssWithFreeDriveScales(const ResponseData& d, const Layout& L, const Resp
   ceres::Problem problem;
   problem.AddResidualBlock(cost, nullptr, x.data(), s.data());
   ceres::Solver::Summary sum;
-  ceres::Solve(denseSolverOptions({200}), &problem, &sum);
+  ceres::Solve(denseSolverOptions({max_iterations}), &problem, &sum);
   ResponseData ds = d;
   ds.resonant_drive_factor.assign(ds.size(), 1.0);
   for (size_t i = 0; i < ds.size(); ++i)
@@ -410,8 +397,8 @@ ResponseParams choosePhaseConvention(FitContext* c, ResponseFit* fit) {
 /// Step 3. The layout: the nonlinear terms asked for, and a background slope in frequency only
 /// where the data ask for it (F test, lag-1 deflated dof). `lin` becomes the linear fit without
 /// a slope when none is needed.
-void chooseLayout(const ResponseTerms& terms, FitContext* c, ResponseParams* lin,
-                  ResponseFit* fit) {
+void chooseLayout(const ResponseTerms& terms, const ResponseFitOptions& o, FitContext* c,
+                  ResponseParams* lin, ResponseFit* fit) {
   const ResponseData& d = c->d;
   Layout& L = c->L;
   for (const ResponseLaw& law : responseLaws()) L.terms.*law.flag = terms.*law.flag;
@@ -420,11 +407,11 @@ void chooseLayout(const ResponseTerms& terms, FitContext* c, ResponseParams* lin
     const double rss0 = gridLinear(d, c->all, false, c->f_ref, &no_slope);
     const double rss1 = projectLinear(d, c->all, lin->f0_hz, lin->width_hz, true, c->f_ref, lin);
     const double rho =
-        std::max(0.0, std::min(kMaxSlopeTestLag1, lag1Along(d, stationaryResponse(*lin, d))));
+        std::max(0.0, std::min(o.slope_test_max_lag1, lag1Along(d, stationaryResponse(*lin, d))));
     const double dof =
-        std::max(kMinSlopeTestDof, (2.0 * c->n - kSlopeModelParams) * (1 - rho) / (1 + rho));
+        std::max(o.slope_test_min_dof, (2.0 * c->n - kSlopeModelParams) * (1 - rho) / (1 + rho));
     const double F = (rss0 - rss1) / 2.0 / (rss1 / dof);
-    L.slope = terms.background_slope || F > kSlopeTestF;
+    L.slope = terms.background_slope || F > o.slope_test_f;
     if (!L.slope) *lin = no_slope;
   }
   fit->notes.push_back(L.slope ? "background: constant + linear in frequency, per unit drive"
@@ -450,18 +437,18 @@ std::map<double, std::vector<int>> pointsByDriveLevel(const ResponseData& d, siz
 /// reference. Returns the |residual| of these free per-level fits (the noise scale).
 std::vector<double> fitEachLevel(const FitContext& c,
                                  const std::map<double, std::vector<int>>& by_level,
-                                 ResponseFit* fit) {
+                                 const ResponseFitOptions& o, ResponseFit* fit) {
   const ResponseData& d = c.d;
   std::vector<double> free_abs;
   for (const auto& kv : by_level) {
-    if (kv.second.size() < kMinLevelPoints) continue;
+    if (kv.second.size() < o.min_level_points) continue;
     ResponseParams p;
     gridLinear(d, kv.second, c.L.slope, c.f_ref, &p);
     const ResponseData dl = subset(d, kv.second);
     Layout lin_layout;
     lin_layout.slope = c.L.slope;
     bool ok = false;
-    const ResponseParams pr = refine(dl, lin_layout, p, kLevelFitIterations, &ok);
+    const ResponseParams pr = refine(dl, lin_layout, p, o.level_fit_iterations, &ok);
     if (ok && costOf(pr, dl) < costOf(p, dl)) p = pr;
     const std::vector<cd> ml = stationaryResponse(p, dl);
     for (size_t i = 0; i < ml.size(); ++i) free_abs.push_back(std::abs(dl.z[i] - ml[i]));
@@ -480,7 +467,8 @@ std::vector<double> fitEachLevel(const FitContext& c,
 /// Step 6. Starts: the linear fit, and for nonlinear terms the per-level trend of f0 and width
 /// in u (least squares over the levels' peaks).
 std::vector<ResponseParams> startsOf(const FitContext& c, const ResponseParams& lin,
-                                     const std::vector<ResponseLevelFit>& levels) {
+                                     const std::vector<ResponseLevelFit>& levels,
+                                     const ResponseFitOptions& o) {
   const Layout& L = c.L;
   std::vector<ResponseParams> starts = {lin};
   if (L.nonlinear() && levels.size() >= 2) {
@@ -499,7 +487,8 @@ std::vector<ResponseParams> startsOf(const FitContext& c, const ResponseParams& 
       ResponseParams s = lin;
       const double xi = (m * suf - su * sf) / den, g = (m * suw - su * sw) / den;
       s.f0_hz = (sf - xi * su) / m;
-      s.width_hz = std::max((sw - g * su) / m, kMinStartWidthFraction * levels.front().width_hz);
+      s.width_hz =
+          std::max((sw - g * su) / m, o.min_start_width_fraction * levels.front().width_hz);
       projectLinear(c.d, c.all, s.f0_hz, s.width_hz, L.slope, c.f_ref, &s);
       if (L.terms.backbone) s.backbone_hz_per_amp2 = xi;
       if (L.terms.width_growth) s.width_growth_hz_per_amp2 = g;
@@ -517,9 +506,9 @@ std::vector<ResponseParams> startsOf(const FitContext& c, const ResponseParams& 
 /// Step 7. Noise scale: the smaller of the median |residual| of the free per-level fits (1.1774
 /// sigma for complex Gaussian noise; inflated where a level is not a Lorentzian) and the second
 /// differences' (which correlated noise lowers). Reorders `free_abs`.
-double noiseScale(const ResponseData& d, std::vector<double>* free_abs) {
+double noiseScale(const ResponseData& d, size_t min_residuals, std::vector<double>* free_abs) {
   double noise = noiseFromDifferences(d);
-  if (free_abs->size() >= kMinResidualsForNoise) {
+  if (free_abs->size() >= min_residuals) {
     std::nth_element(free_abs->begin(), free_abs->begin() + free_abs->size() / 2, free_abs->end());
     noise = std::min(noise, (*free_abs)[free_abs->size() / 2] / kMedianAbsPerSigma);
   }
@@ -532,34 +521,35 @@ struct RobustRefiner {
   const Layout& L;
   size_t n;
   double noise;
+  const ResponseFitOptions& o;
 
-  /// The Huber threshold follows the fit's own misfit: 3 scales of the larger of the noise and
-  /// the median residual of the stage's start (a model that misses everywhere is not clipped
-  /// everywhere, which would stall Levenberg-Marquardt).
+  /// The Huber threshold follows the fit's own misfit: o.huber_noise_scales (3) of the larger of
+  /// the noise and the median residual of the stage's start (a model that misses everywhere is not
+  /// clipped everywhere, which would stall Levenberg-Marquardt).
   double deltaAt(const ResponseParams& p, BranchChoice c) const {
     const std::vector<cd> m = stationaryResponse(p, d, nullptr, nullptr, c);
     std::vector<double> a(n);
     for (size_t i = 0; i < n; ++i) a[i] = std::abs(d.z[i] - m[i]);
     std::nth_element(a.begin(), a.begin() + n / 2, a.end());
-    return kHuberNoiseScales * std::max(noise, a[n / 2] / kMedianAbsPerSigma);
+    return o.huber_noise_scales * std::max(noise, a[n / 2] / kMedianAbsPerSigma);
   }
 
   /// A stage refines with the threshold of its start's misfit, then again while the misfit keeps
-  /// falling (at most 4 rounds), so a start far off is not clipped everywhere and a close one
-  /// ends with the noise's threshold.
+  /// falling (at most o.max_huber_rounds), so a start far off is not clipped everywhere and a close
+  /// one ends with the noise's threshold.
   ResponseParams robustRefine(ResponseParams t, BranchChoice c, bool* ok,
                               double* delta_used) const {
     double dl = deltaAt(t, c);
     *ok = false;
-    for (int round = 0; round < kMaxHuberRounds; ++round) {
+    for (int round = 0; round < o.max_huber_rounds; ++round) {
       bool ok_round = false;
-      const ResponseParams p = refine(d, L, t, kRobustFitIterations, &ok_round, c, dl);
+      const ResponseParams p = refine(d, L, t, o.robust_fit_iterations, &ok_round, c, dl);
       if (!ok_round) break;
       *ok = true;
       t = p;
       const double next = deltaAt(t, c);
       *delta_used = dl;
-      if (!(next < kHuberShrinkForAnotherRound * dl)) break;
+      if (!(next < o.huber_shrink_for_another_round * dl)) break;
       dl = next;
     }
     return t;
@@ -580,13 +570,14 @@ struct BestFit {
 /// differences along the sweeps); candidates are compared on 3 noise scales. Sets
 /// fit->converged when a refit converged.
 BestFit refineStarts(const FitContext& c, const std::vector<ResponseParams>& starts,
-                     const ResponseParams& lin, double noise, ResponseFit* fit) {
+                     const ResponseParams& lin, double noise, const ResponseFitOptions& o,
+                     ResponseFit* fit) {
   const ResponseData& d = c.d;
   const Layout& L = c.L;
-  const RobustRefiner rr{d, L, c.n, noise};
+  const RobustRefiner rr{d, L, c.n, noise, o};
   double best_cost = std::numeric_limits<double>::infinity();
   ResponseParams best = lin;
-  const double delta_compare = kHuberNoiseScales * noise;
+  const double delta_compare = o.huber_noise_scales * noise;
   double delta = delta_compare;
   for (const ResponseParams& s : starts) {
     std::vector<ResponseParams> tries = {s};
@@ -598,7 +589,7 @@ BestFit refineStarts(const FitContext& c, const std::vector<ResponseParams>& sta
     }
     if (L.nonlinear()) {  // and the noise's threshold from the start (a fold's point clipped)
       bool ok_fixed = false;
-      const ResponseParams sf = refine(d, L, s, kRobustFitIterations, &ok_fixed,
+      const ResponseParams sf = refine(d, L, s, o.robust_fit_iterations, &ok_fixed,
                                        BranchChoice::kNearestData, delta_compare);
       if (ok_fixed) tries.push_back(sf);
     }
@@ -606,7 +597,7 @@ BestFit refineStarts(const FitContext& c, const std::vector<ResponseParams>& sta
       bool ok = false;
       double used = delta_compare;
       const ResponseParams p = k + 1 == tries.size() && L.nonlinear()
-                                   ? refine(d, L, tries[k], kRobustFitIterations, &ok,
+                                   ? refine(d, L, tries[k], o.robust_fit_iterations, &ok,
                                             BranchChoice::kFollow, delta_compare)
                                    : rr.robustRefine(tries[k], BranchChoice::kFollow, &ok, &used);
       const double cost = costOf(p, d, delta_compare);
@@ -623,7 +614,7 @@ BestFit refineStarts(const FitContext& c, const std::vector<ResponseParams>& sta
 
 /// Step 9. Statistics, model, parameters and point estimates in the input's units.
 void fillPointEstimates(const FitContext& c, const ResponseParams& best, double delta,
-                        ResponseFit* fit) {
+                        const ResponseFitOptions& o, ResponseFit* fit) {
   const ResponseData& d = c.d;
   const Layout& L = c.L;
   const size_t n = c.n;
@@ -636,8 +627,9 @@ void fillPointEstimates(const FitContext& c, const ResponseParams& best, double 
   fit->rss = costOf(best, d) * zs * zs;
   int far = 0;
   for (size_t i = 0; i < n; ++i) far += std::abs(d.z[i] - m[i]) > delta ? 1 : 0;
-  fit->notes.push_back("Huber weights beyond " + std::to_string(delta * zs) +
-                       " (3 scales of the noise or of the median misfit): " + std::to_string(far) +
+  fit->notes.push_back("Huber weights beyond " + std::to_string(delta * zs) + " (" +
+                       fmtG(o.huber_noise_scales) +
+                       " scales of the noise or of the median misfit): " + std::to_string(far) +
                        " of " + std::to_string(n) + " points down-weighted");
   fit->sigma = std::sqrt(fit->rss / std::max(1, static_cast<int>(2 * n) - L.size()));
   for (auto& z : m) z = (fit->conjugated ? std::conj(z) : z) * zs;
@@ -656,15 +648,16 @@ void fillPointEstimates(const FitContext& c, const ResponseParams& best, double 
 
 /// Step 10. The amplitude law's check: would a free drive factor per level fit much better?
 void checkLevelGains(const FitContext& c, const std::map<double, std::vector<int>>& by_level,
-                     const ResponseParams& best, ResponseFit* fit) {
+                     const ResponseParams& best, const ResponseFitOptions& o, ResponseFit* fit) {
   std::vector<int> level(c.n, 0);
   int k = 0;
   for (const auto& kv : by_level) {
     for (int i : kv.second) level[i] = k;
     ++k;
   }
-  fit->rss_free_level_gains =
-      std::min(fit->rss, rssWithFreeDriveScales(c.d, c.L, best, level, k, 0.0) * c.zs * c.zs);
+  fit->rss_free_level_gains = std::min(
+      fit->rss, rssWithFreeDriveScales(c.d, c.L, best, level, k, 0.0, o.level_gain_fit_iterations) *
+                    c.zs * c.zs);
 }
 
 /// The column-scaled Jacobian at the optimum and its SVD.
@@ -696,9 +689,9 @@ void markNotDetermined(const Layout& L, const ScaledJacobian& sj, const Response
   const Eigen::VectorXd& sv = sj.sv;
   std::vector<bool> weak(L.size(), false);
   for (int k = 0; k < sv.size(); ++k) {
-    if (sv(k) > o.rank_tolerance * kWeakDirectionToleranceFactor * sv(0)) continue;
+    if (sv(k) > o.rank_tolerance * o.weak_direction_tolerance_factor * sv(0)) continue;
     for (int j = 0; j < L.size(); ++j)
-      if (std::abs(sj.svd.matrixV()(j, k)) > kWeakDirectionLoading) weak[j] = true;
+      if (std::abs(sj.svd.matrixV()(j, k)) > o.weak_direction_loading) weak[j] = true;
   }
   std::vector<std::string> weak_derived;
   {
@@ -804,7 +797,9 @@ void applySandwich(const FitContext& c, const std::map<std::string, double>& san
 /// that converged.
 std::map<std::string, std::vector<double>> leaveOneSweepOut(const FitContext& c,
                                                             const ResponseParams& best,
-                                                            double delta, int G, int* used) {
+                                                            double delta, int G,
+                                                            const ResponseFitOptions& o,
+                                                            int* used) {
   const ResponseData& d = c.d;
   const Layout& L = c.L;
   std::map<std::string, std::vector<double>> reps;
@@ -817,11 +812,11 @@ std::map<std::string, std::vector<double>> leaveOneSweepOut(const FitContext& c,
     bool ok_smooth = false, ok = false;
     ResponseParams pg = best;
     if (L.nonlinear()) {
-      const ResponseParams ps = refine(dg, L, best, kJackknifeRefitIterations, &ok_smooth,
+      const ResponseParams ps = refine(dg, L, best, o.jackknife_refit_iterations, &ok_smooth,
                                        BranchChoice::kNearestData, delta);
       if (ok_smooth) pg = ps;
     }
-    pg = refine(dg, L, pg, kJackknifeRefitIterations, &ok, BranchChoice::kFollow, delta);
+    pg = refine(dg, L, pg, o.jackknife_refit_iterations, &ok, BranchChoice::kFollow, delta);
     if (!ok || !(pg.width_hz > 0)) continue;
     ++*used;
     for (const auto& kv : derivedOf(pg, L, c.zs * c.zs)) reps[kv.first].push_back(kv.second);
@@ -833,11 +828,12 @@ std::map<std::string, std::vector<double>> leaveOneSweepOut(const FitContext& c,
 /// unless the sandwich's is larger where a fold can trap a refit (a refit that cannot leave a
 /// fold-trap would make the jackknife's spread too small).
 void jackknifeOverSweeps(const FitContext& c, const ResponseParams& best, double delta, int G,
-                         const std::map<std::string, double>& sandwich_std, ResponseFit* fit) {
+                         const std::map<std::string, double>& sandwich_std,
+                         const ResponseFitOptions& o, ResponseFit* fit) {
   const Layout& L = c.L;
   int used = 0;
   const std::map<std::string, std::vector<double>> reps =
-      leaveOneSweepOut(c, best, delta, G, &used);
+      leaveOneSweepOut(c, best, delta, G, o, &used);
   // Student t with the jackknife's effective degrees of freedom: G - 1 when the sweeps weigh
   // alike, fewer when a few sweeps carry the estimate (the high drive levels, a drift of f0
   // between sweeps): 3 (sum d^2)^2 / sum d^4 of the leave-one-out deviations d (= G for
@@ -941,19 +937,19 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   fit.kind = o.kind;
   normalise(data_in, o, &c);
   ResponseParams lin = choosePhaseConvention(&c, &fit);
-  chooseLayout(terms, &c, &lin, &fit);
+  chooseLayout(terms, o, &c, &lin, &fit);
   const std::map<double, std::vector<int>> by_level = pointsByDriveLevel(c.d, c.n);
-  std::vector<double> free_abs = fitEachLevel(c, by_level, &fit);
+  std::vector<double> free_abs = fitEachLevel(c, by_level, o, &fit);
   fit.n_drive_levels = static_cast<int>(by_level.size());
-  const std::vector<ResponseParams> starts = startsOf(c, lin, fit.levels);
-  const double noise = noiseScale(c.d, &free_abs);
-  const BestFit bf = refineStarts(c, starts, lin, noise, &fit);
+  const std::vector<ResponseParams> starts = startsOf(c, lin, fit.levels, o);
+  const double noise = noiseScale(c.d, o.min_residuals_for_noise, &free_abs);
+  const BestFit bf = refineStarts(c, starts, lin, noise, o, &fit);
   const ResponseParams& best = bf.params;
   const double delta = bf.delta;
   if (!fit.converged || !(best.width_hz > 0))
     throw AnalysisError("the response fit did not converge");
-  fillPointEstimates(c, best, delta, &fit);
-  if (o.level_gain_check && by_level.size() >= 2) checkLevelGains(c, by_level, best, &fit);
+  fillPointEstimates(c, best, delta, o, &fit);
+  if (o.level_gain_check && by_level.size() >= 2) checkLevelGains(c, by_level, best, o, &fit);
   if (!o.intervals) return fit;
 
   const ScaledJacobian sj = scaledJacobianAt(c, best);
@@ -964,7 +960,8 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   const int G = fit.n_sweeps;
   const std::map<std::string, double> sandwich_std = sandwichStd(c, best, delta, sj, o);
   applySandwich(c, sandwich_std, G, &fit);
-  if (G >= o.min_sweeps_for_jackknife) jackknifeOverSweeps(c, best, delta, G, sandwich_std, &fit);
+  if (G >= o.min_sweeps_for_jackknife)
+    jackknifeOverSweeps(c, best, delta, G, sandwich_std, o, &fit);
   setIntervals(o, &fit);
   if (o.require_resonance) requireResponseResonance(fit);
   addModelTerms(&fit);

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <complex>
+#include <cstddef>
 #include <map>
 #include <string>
 #include <vector>
@@ -30,6 +31,59 @@ struct ResponseFitOptions {
   /// candidate fits turn it off and check the selected one only: a rival model's misfit must not
   /// refuse a record the selected model describes.
   bool require_resonance = true;
+
+  // Tuned thresholds of the fit's steps (response_fit.cpp; docs/response.md, "Fit"). Iteration
+  // caps are Levenberg-Marquardt iterations (Ceres).
+
+  /// Background slope (step 3): largest lag-1 residual correlation rho by which the F test deflates
+  /// its denominator's dof, (2 n - 8) (1 - rho) / (1 + rho) (dimensionless). Set by hand (commit
+  /// ea65a3c), no recorded evidence.
+  double slope_test_max_lag1 = 0.95;
+  /// Background slope: smallest dof of the F test's denominator after the deflation. Set by hand
+  /// (commit ea65a3c), no recorded evidence.
+  double slope_test_min_dof = 4.0;
+  /// Background slope: F (2 numerator dof) above which a slope in frequency is fitted. ~p < 1e-6
+  /// for F(2, dof large) (the reason recorded with it, commit ea65a3c); docs/response.md states it.
+  double slope_test_f = 15.0;
+  /// Fewest points of a drive level for its own Lorentzian fit (step 5; a smaller level gives no
+  /// start and no noise scale). Set by hand (commit ea65a3c), no recorded evidence.
+  size_t min_level_points = 8;
+  /// Iteration cap of a drive level's own Lorentzian fit (step 5). Set by hand (commit 941e0d5),
+  /// no recorded evidence.
+  int level_fit_iterations = 200;
+  /// Iteration cap of the refit with a free drive factor per level (step 10, level_gain_check).
+  /// Set by hand (commit 1e67f1f), no recorded evidence.
+  int level_gain_fit_iterations = 200;
+  /// The per-level trend's start (step 6) has a width of at least this fraction of the first
+  /// level's width. Set by hand (commit ea65a3c), no recorded evidence.
+  double min_start_width_fraction = 0.2;
+  /// Fewest residuals of the free per-level fits whose median is taken as a noise scale (step 7;
+  /// else the second differences' alone). Set by hand (commit 941e0d5), no recorded evidence.
+  size_t min_residuals_for_noise = 8;
+  /// Huber threshold in noise scales (step 8: of the larger of the noise and the stage's median
+  /// misfit / 1.1774; also the scale candidates are compared on). Huber weights came in after the
+  /// tuning runs (seed base 7100000) found the fit stalled at a fold (docs/validation_response.md,
+  /// "Order of work"); the value 3 was set by hand (commit 4233c0d), no recorded evidence for it.
+  double huber_noise_scales = 3.0;
+  /// Most Huber rounds of a robust refinement, the threshold following the misfit (step 8). Set by
+  /// hand (commit 6574900), no recorded evidence.
+  int max_huber_rounds = 4;
+  /// Iteration cap of each refinement of a start (step 8). Set by hand (commit ea65a3c), no
+  /// recorded evidence.
+  int robust_fit_iterations = 300;
+  /// Another Huber round only while the new threshold is below this fraction of the last (step 8).
+  /// Set by hand (commit 6574900), no recorded evidence.
+  double huber_shrink_for_another_round = 0.8;
+  /// A direction is not determined (step 11b) when its relative singular value is at most
+  /// rank_tolerance times this (1e-6 with the defaults). Set by hand (commit ea65a3c), no recorded
+  /// evidence.
+  double weak_direction_tolerance_factor = 1e3;
+  /// A parameter takes part in such a direction when its component in the (unit) right singular
+  /// vector exceeds this. Set by hand (commit ea65a3c), no recorded evidence.
+  double weak_direction_loading = 0.3;
+  /// Iteration cap of each jackknife refit (step 13a, per stage). Set by hand (commit ea65a3c), no
+  /// recorded evidence.
+  int jackknife_refit_iterations = 100;
 };
 
 /// A linear Lorentzian fitted to one drive level alone (the initialiser and the adequacy
