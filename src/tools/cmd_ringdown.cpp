@@ -17,6 +17,7 @@
 #include "cvg_bench/core/simulate/ringdown_simulator.h"
 #include "cvg_bench/core/single_mode/ringdown_causes.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
+#include "cvg_bench/core/single_mode/ringdown_laws.h"
 #include "cvg_bench/core/single_mode/ringdown_span_spread.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_bench/report/ringdown_json.h"
@@ -73,6 +74,28 @@ std::vector<std::string> splitList(const std::string& s) {
   std::string item;
   while (std::getline(ss, item, ','))
     if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+/// The generator's coefficient of a ring-down law (--effect NAME=V): an amplitude law's, by the
+/// power of A in its rate (the generator's dA/dt = -(g0 + gamma_nl A^2 + gamma_a A) A); nullptr
+/// for a law the generator has no coefficient of.
+double* simulatedCoefficient(const RingdownLaw& law, RingdownSimulationOptions& o) {
+  if (law.kind != RingdownLawKind::kAmplitudeLaw) return nullptr;
+  if (law.amplitude_power == 2) return &o.gamma_nl;
+  if (law.amplitude_power == 1) return &o.gamma_a;
+  return nullptr;
+}
+
+/// The laws --effect takes, as the message lists them ("a or b", "a, b or c").
+std::string simulatedLawNames() {
+  RingdownSimulationOptions probe;
+  std::vector<std::string> names;
+  for (const RingdownLaw& law : ringdownLaws())
+    if (simulatedCoefficient(law, probe)) names.push_back(law.name);
+  std::string out;
+  for (size_t k = 0; k < names.size(); ++k)
+    out += (k == 0 ? "" : k + 1 == names.size() ? " or " : ", ") + names[k];
   return out;
 }
 
@@ -356,12 +379,11 @@ int runRingdownSimulate(const std::vector<std::string>& argv) {
     } catch (const std::exception&) {
       throw InputError("--effect " + name + ": not a number: '" + e.substr(eq + 1) + "'");
     }
-    if (name == "gamma_nl")
-      o.gamma_nl = v;
-    else if (name == "gamma_a")
-      o.gamma_a = v;
-    else
-      throw InputError("--effect for ring-downs: gamma_nl or gamma_a, got '" + name + "'");
+    const RingdownLaw* law = findRingdownLaw(name);
+    double* coefficient = law ? simulatedCoefficient(*law, o) : nullptr;
+    if (!coefficient)
+      throw InputError("--effect for ring-downs: " + simulatedLawNames() + ", got '" + name + "'");
+    *coefficient = v;
   }
   const RingdownRecord rec = simulateRingdown(o);
   std::ofstream out(args.get("out"));

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <boost/math/distributions/chi_squared.hpp>
 #include <cmath>
 #include <limits>
@@ -23,27 +24,16 @@ constexpr double kTinyPositive = 1e-300;
 /// Parameters of the single exponential (ln A0 and its rate): an extension's likelihood-ratio
 /// test has its parameters beyond these as degrees of freedom.
 constexpr int kLineParams = 2;
-/// The beat's searched split in the criterion: it pays kBeatSplitPenalty ln(max(kBeatSplitMinGrid,
-/// n / kBeatSplitGridDivisor)) on top of its parameters (ringdown_causes.h: "the beat also pays
-/// for its searched split").
-constexpr double kBeatSplitPenalty = 2.0;
-constexpr double kBeatSplitMinGrid = 2.0;      ///< see kBeatSplitPenalty
-constexpr double kBeatSplitGridDivisor = 4.0;  ///< see kBeatSplitPenalty
-/// Spread of the detector filter's time-constant estimate on simulated floors: a choice through
-/// the filter must hold at 1 / kFilterSpread, 1 and kFilterSpread times the estimate.
-constexpr double kFilterSpread = 1.4;
-/// The time-constant scales a choice through the filter must hold at (the estimate's first).
+/// The time-constant scales a choice through the filter must hold at (the estimate's first, then
+/// 1 / and times RingdownExplainOptions::filter_spread): their number.
 constexpr int kFilterScaleCount = 3;
-constexpr double kFilterScales[kFilterScaleCount] = {1.0, 1.0 / kFilterSpread, kFilterSpread};
 /// "No filter scale looked at yet" for the law common to every filter scale (-1: none common).
 constexpr int kNoCommonPickYet = -2;
 /// Digits of the criteria printed in law_choice when no extension passed on the span.
 constexpr int kLawChoiceDigits = 6;
-/// Hold-out confirmation: a beat or a two-stage decay (4 parameters more than the line, a searched
-/// split) must predict held-out blocks below this fraction of its rival's error (10 % better)...
-constexpr double kHoldOutFactorExtension = 0.9;
-/// ... an amplitude law (1 parameter more) just below its rival's.
-constexpr double kHoldOutFactorLaw = 1.0;
+/// Step of the central differences of the lack-of-fit test's model columns, relative to
+/// 1 + |parameter| (the least-squares kernel's step, estimate/numeric_least_squares).
+constexpr double kDerivativeStep = 1e-6;
 
 double chi2Upper(int df, double x) {
   if (!(x > 0.0)) return 1.0;
@@ -57,23 +47,15 @@ std::string fmt(double v, int prec = 4) {
   return s.str();
 }
 
-/// Physical plausibility (sign checks) of an extension's fit; returns "" when plausible.
-std::string signCheck(const RingdownFit& f) {
-  const auto& p = f.p;
-  if (f.model == "gamma_nl" || f.model == "gamma_a") {
-    if (p(1) <= 0.0) return "zero-amplitude damping g0 fitted negative";
-    if (p(2) <= 0.0)
-      return "amplitude-dependent damping fitted negative (decay accelerates as the amplitude "
-             "falls: no physical damping law)";
-  } else if (f.model == "beat") {
-    if (p(1) <= 0.0 || p(3) <= 0.0) return "a mode's decay rate fitted negative";
-    if (p(4) < 4.0 * M_PI) return "under two beat periods in the span (a step is not a beat)";
-    if (p(2) - p(0) < std::log(0.005)) return "second mode below 0.5 % of the first";
-  } else if (f.model == "two_stage") {
-    if (p(1) <= 0.0 || p(3) <= 0.0) return "a stage's decay rate fitted negative";
-    if (p(1) < 1.5 * p(3)) return "the two stages' rates differ by under 1.5x";
-  }
-  return "";
+/// Physical plausibility (sign checks) of an extension's fit (its law's check); returns "" when
+/// plausible.
+std::string signCheck(const RingdownFit& f, const RingdownPlausibilityOptions& o) {
+  return ringdownLaw(f.model).physical_check(f.p, o);
+}
+
+/// Whether the law of that name depends on the amplitude (RingdownLawKind::kAmplitudeLaw).
+bool isAmplitudeLaw(const std::string& c) {
+  return ringdownLaw(c).kind == RingdownLawKind::kAmplitudeLaw;
 }
 
 /// RMS over the middle 80 % of the span [t.front(), t.back()] (41 points, slopes over 4 % of the
@@ -83,7 +65,7 @@ std::string signCheck(const RingdownFit& f) {
 /// bounds, not a damping law (over the whole span, 62 of 154 clean tuning records read as
 /// unexplained against 45 over the middle).
 double curveRateVariation(const std::vector<double>& t, const std::vector<double>& curve,
-                          double mean_rate) {
+                          double mean_rate, const RingdownLackOfFitOptions& o) {
   const size_t n = t.size();
   if (n < 3 || curve.size() != n) return 0.0;
   const double t0 = t.front(), span_s = t.back() - t0;
@@ -95,11 +77,11 @@ double curveRateVariation(const std::vector<double>& t, const std::vector<double
     const double u = (x - t[j - 1]) / (t[j] - t[j - 1]);
     return curve[j - 1] + u * (curve[j] - curve[j - 1]);
   };
-  const double h = 0.02 * span_s;
+  const double h = o.slope_half_width * span_s;
   double ss = 0.0;
   int k = 0;
-  for (int j = 0; j <= 40; ++j, ++k) {
-    const double x = t0 + span_s * (0.1 + 0.8 * j / 40.0);
+  for (int j = 0; j <= o.rate_points; ++j, ++k) {
+    const double x = t0 + span_s * (o.middle_start + o.middle_width * j / o.rate_points);
     const double rel = (at(x + h) - at(x - h)) / (2.0 * h) / mean_rate;
     ss += rel * rel;
   }
@@ -118,7 +100,7 @@ double meanDecayRate(const RingdownFit& f) {
 /// how far the local decay rate wanders from the model's, which is what a person reads off a dB
 /// plot.
 double misfitRateVariation(const Eigen::MatrixXd& X, const Eigen::VectorXd& r,
-                           const RingdownFit& fit) {
+                           const RingdownFit& fit, const RingdownLackOfFitOptions& o) {
   const int n = static_cast<int>(r.size());
   if (n < 3 || !X.allFinite() || !r.allFinite()) return 0.0;
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(X);
@@ -126,7 +108,7 @@ double misfitRateVariation(const Eigen::MatrixXd& X, const Eigen::VectorXd& r,
   const Eigen::VectorXd fitted_w = X * qr.solve(r);
   std::vector<double> m(n);
   for (int i = 0; i < n; ++i) m[i] = fitted_w(i) / std::sqrt(fit.weight[i]);  // Np
-  return curveRateVariation(fit.t_s, m, meanDecayRate(fit));
+  return curveRateVariation(fit.t_s, m, meanDecayRate(fit), o);
 }
 
 }  // namespace
@@ -146,12 +128,11 @@ std::vector<std::string> RingdownExplainOptions::validate() const {
   return out;
 }
 
-constexpr int kLackOfFitBlocks = 4;
-
-RingdownLackOfFit ringdownLackOfFit(const RingdownFit& fit) {
+RingdownLackOfFit ringdownLackOfFit(const RingdownFit& fit,
+                                    const RingdownLackOfFitOptions& options) {
   RingdownLackOfFit out;
   const int n = fit.n, p = fit.n_params;
-  if (n < p + 12) return out;
+  if (n < p + options.min_samples_over_parameters) return out;
   const int q = 4;
   Eigen::MatrixXd X(n, p + q);
   Eigen::VectorXd r(n);
@@ -160,7 +141,7 @@ RingdownLackOfFit ringdownLackOfFit(const RingdownFit& fit) {
     const double sw = std::sqrt(fit.weight[i]);
     r(i) = sw * (fit.log_amplitude[i] - fit.fitted[i]);
     for (int k = 0; k < p; ++k) {
-      const double h = 1e-6 * (1.0 + std::fabs(fit.p(k)));
+      const double h = kDerivativeStep * (1.0 + std::fabs(fit.p(k)));
       Eigen::VectorXd pp = fit.p, pm = fit.p;
       pp(k) += h, pm(k) -= h;
       X(i, k) = sw *
@@ -174,16 +155,17 @@ RingdownLackOfFit ringdownLackOfFit(const RingdownFit& fit) {
     const double P5 = (63 * std::pow(x, 5) - 70 * x * x * x + 15 * x) / 8.0;
     X(i, p) = sw * P2, X(i, p + 1) = sw * P3, X(i, p + 2) = sw * P4, X(i, p + 3) = sw * P5;
   }
-  out.p_value = ringdownAddedTermsP(X, r, q);
-  out.rate_variation = misfitRateVariation(X, r, fit);
+  out.p_value = ringdownAddedTermsP(X, r, q, options);
+  out.rate_variation = misfitRateVariation(X, r, fit, options);
   return out;
 }
 
-double ringdownLackOfFitP(const RingdownFit& fit) {
-  return ringdownLackOfFit(fit).p_value;
+double ringdownLackOfFitP(const RingdownFit& fit, const RingdownLackOfFitOptions& options) {
+  return ringdownLackOfFit(fit, options).p_value;
 }
 
-double ringdownAddedTermsP(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, int q) {
+double ringdownAddedTermsP(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, int q,
+                           const RingdownLackOfFitOptions& options) {
   const int m = static_cast<int>(X.cols());
   if (!X.allFinite() || !r.allFinite() || q < 1 || q >= m) return 1.0;
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(X);
@@ -197,7 +179,7 @@ double ringdownAddedTermsP(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, i
   double p_value = 0.0;
   for (int local = 0; local < 2; ++local) {
     const ArNoiseCovariance cov =
-        local ? arNoiseCovarianceLocal(X, e, kLackOfFitBlocks) : arNoiseCovariance(X, e, false);
+        local ? arNoiseCovarianceLocal(X, e, options.ar_blocks) : arNoiseCovariance(X, e, false);
     const Eigen::MatrixXd C = cov.covariance.bottomRightCorner(q, q);
     const double w = bq.dot(C.colPivHouseholderQr().solve(bq));
     if (!std::isfinite(w)) continue;  // no usable noise model: that one shows nothing
@@ -208,25 +190,28 @@ double ringdownAddedTermsP(const Eigen::MatrixXd& X, const Eigen::VectorXd& r, i
 
 namespace {
 
-/// Blocked two-fold hold-out error of a model: the span's used samples in kHoldOutBlocks
+/// Blocked two-fold hold-out error of a model: the span's used samples in options.hold_out_blocks
 /// contiguous blocks, fitted on the even blocks and scored on the odd ones between them and back,
 /// started from the full fit. Returns the weighted squared prediction error over all samples (inf
 /// on failure).
-constexpr int kHoldOutBlocks = 48;
 double holdOutError(const RingdownEnvelope& env, const RingdownSegment& seg,
-                    const RingdownFit& full, const RingdownFitOptions& base) {
+                    const RingdownFit& full, const RingdownExplainOptions& options) {
+  const RingdownFitOptions& base = options.fit;
+  const int blocks = options.hold_out_blocks;
   std::vector<size_t> used;
   for (size_t i = seg.i_start; i < seg.i_end; ++i)
     if (!seg.dropout[i] && std::isfinite(env.log_amplitude[i])) used.push_back(i);
   const size_t n = used.size();
-  if (n != full.t_s.size() || n < 4 * kHoldOutBlocks) return kInfinity;
+  if (n != full.t_s.size() ||
+      n < static_cast<size_t>(options.hold_out_min_samples_per_block * blocks))
+    return kInfinity;
   double err = 0.0;
   for (int fold = 0; fold < 2; ++fold) {
     RingdownFitOptions o = base;
     o.details = false;
     o.hold_out.assign(env.size(), false);
     for (size_t k = 0; k < n; ++k)
-      o.hold_out[used[k]] = static_cast<int>(k * kHoldOutBlocks / n) % 2 != fold;
+      o.hold_out[used[k]] = static_cast<int>(k * blocks / n) % 2 != fold;
     RingdownFit f;
     try {
       f = fitRingdown(env, seg, full.model, o, {full.p});
@@ -246,10 +231,6 @@ double holdOutError(const RingdownEnvelope& env, const RingdownSegment& seg,
     }
   }
   return err;
-}
-
-bool isAmplitudeLaw(const std::string& c) {
-  return c == "gamma_nl" || c == "gamma_a";
 }
 
 /// What the steps of explainRingdown hand on to each other (one per call).
@@ -317,12 +298,14 @@ double whitenedSse(const std::vector<double>& ar, const RingdownFit& f) {
   return sse;
 }
 
-/// BIC of a fit on the whitened sum of squares over n samples; the beat also pays for its
-/// searched split.
-double informationCriterion(const std::vector<double>& ar, double n, const RingdownFit& f) {
+/// BIC of a fit on the whitened sum of squares over n samples; a law with a searched split
+/// frequency (the beat) also pays for the search.
+double informationCriterion(const std::vector<double>& ar, double n, const RingdownFit& f,
+                            const RingdownExplainOptions& o) {
   double pen = f.n_params * std::log(n);
-  if (f.model == "beat")
-    pen += kBeatSplitPenalty * std::log(std::max(kBeatSplitMinGrid, n / kBeatSplitGridDivisor));
+  if (ringdownLaw(f.model).searched_frequency)
+    pen += o.split_search_penalty *
+           std::log(std::max(o.split_search_min_grid, n / o.split_search_grid_divisor));
   return n * std::log(std::max(whitenedSse(ar, f), kTinyPositive) / n) + pen;
 }
 
@@ -333,7 +316,7 @@ void scoreCandidates(ExplainState& st) {
   const RingdownExplainOptions& options = st.options;
   const double n = static_cast<double>(x.baseline.n);
   const double n_eff = n;
-  st.ic_lin = informationCriterion(st.ar, n, x.baseline);
+  st.ic_lin = informationCriterion(st.ar, n, x.baseline, options);
   x.information_criterion["linear"] = st.ic_lin;
   st.steps.resize(st.nc);
   for (int k = 0; k < st.nc; ++k) {
@@ -346,11 +329,11 @@ void scoreCandidates(ExplainState& st) {
     s.sigma_ratio = x.baseline.sigma / std::max(f.sigma, kTinyPositive);
     s.lr_statistic = n * std::log(std::max(whitenedSse(st.ar, x.baseline), kTinyPositive) /
                                   std::max(whitenedSse(st.ar, f), kTinyPositive));
-    s.information_criterion = informationCriterion(st.ar, n, f);
+    s.information_criterion = informationCriterion(st.ar, n, f, options);
     s.threshold = s.information_criterion - st.ic_lin + s.lr_statistic + options.margin;
     s.p_value = chi2Upper(f.n_params - kLineParams, s.lr_statistic);
     s.significant = st.ic_lin - s.information_criterion > options.margin;
-    s.note = signCheck(f);
+    s.note = signCheck(f, options.plausibility);
     s.physical = s.note.empty();
     if (f.fitted.size() == x.baseline.fitted.size()) {
       for (size_t i = 0; i < f.fitted.size(); ++i)
@@ -390,6 +373,11 @@ void rankCandidates(ExplainState& st) {
   }
 }
 
+/// The time-constant scales a choice through the filter must hold at: the estimate's first.
+std::array<double, kFilterScaleCount> filterScales(const RingdownExplainOptions& o) {
+  return {1.0, 1.0 / o.filter_spread, o.filter_spread};
+}
+
 /// The detector filter with its time constant times s.
 RingdownDetectorFilter scaledFilter(const RingdownDetectorFilter& estimate, double s) {
   RingdownDetectorFilter f = estimate;
@@ -424,9 +412,10 @@ void compareLawsThroughFilter(ExplainState& st) {
     x.law_choice = "no detector filter estimated: the laws compared on the span alone";
   } else {
     std::ostringstream w;
-    w << "through the detector filter (T x 1, 1/" << kFilterSpread << ", " << kFilterSpread << "):";
+    w << "through the detector filter (T x 1, 1/" << st.options.filter_spread << ", "
+      << st.options.filter_spread << "):";
     int votes = 0;
-    for (double sc : kFilterScales) {
+    for (double sc : filterScales(st.options)) {
       const RingdownDetectorFilter filt = scaledFilter(x.detector_filter, sc);
       const RingdownFilteredFit fb =
           fitRingdownThroughFilter(st.env, x.segment, st.fits[best], filt, st.ar);
@@ -460,10 +449,11 @@ void addLawThroughFilter(ExplainState& st) {
   RingdownExplanation& x = st.x;
   std::ostringstream w;
   w.precision(kLawChoiceDigits);
-  w << "no extension on the span; through the detector filter (T x 1, 1/" << kFilterSpread << ", "
-    << kFilterSpread << ") from the plateau on, criteria:";
+  w << "no extension on the span; through the detector filter (T x 1, 1/"
+    << st.options.filter_spread << ", " << st.options.filter_spread
+    << ") from the plateau on, criteria:";
   int common = kNoCommonPickYet;
-  for (double sc : kFilterScales) {
+  for (double sc : filterScales(st.options)) {
     const RingdownDetectorFilter filt = scaledFilter(x.detector_filter, sc);
     const RingdownFilteredFit fl =
         fitRingdownThroughFilter(st.env, x.segment, x.baseline, filt, st.ar);
@@ -500,8 +490,8 @@ void addLawThroughFilter(ExplainState& st) {
 /// through it from the plateau on (ringdown_filter.h): the span skips the filter's settling, which
 /// is where a law in A^2 spends its extra rate. A filter taken too slow makes the corner rounder
 /// than it is and favours the law with more early rate (and the reverse), so a choice through the
-/// filter counts only when it holds with the time constant at 1 / kFilterSpread, 1 and
-/// kFilterSpread times its estimate (the estimate's spread on simulated floors).
+/// filter counts only when it holds with the time constant at 1 / filter_spread, 1 and
+/// filter_spread times its estimate (the estimate's spread on simulated floors).
 void chooseLawThroughFilter(ExplainState& st) {
   RingdownExplanation& x = st.x;
   x.detector_filter =
@@ -530,8 +520,8 @@ bool confirmCandidate(ExplainState& st, HoldOutRivals* rivals, int k) {
   std::optional<double>& cv_lin = rivals->cv_lin;
   std::optional<double>& cv_laws = rivals->cv_laws;
   RingdownStep& s = st.steps[k];
-  s.hold_out_error = holdOutError(st.env, x.segment, st.fits[k], options.fit);
-  if (!cv_lin) cv_lin = holdOutError(st.env, x.segment, x.baseline, options.fit);
+  s.hold_out_error = holdOutError(st.env, x.segment, st.fits[k], options);
+  if (!cv_lin) cv_lin = holdOutError(st.env, x.segment, x.baseline, options);
   double cv_rival = *cv_lin;
   if (!isAmplitudeLaw(s.added)) {
     if (!cv_laws) {
@@ -539,7 +529,7 @@ bool confirmCandidate(ExplainState& st, HoldOutRivals* rivals, int k) {
       for (int j = 0; j < st.nc; ++j)
         if (st.ok[j] && isAmplitudeLaw(st.steps[j].added) && st.steps[j].physical &&
             st.steps[j].significant)
-          m = std::min(m, holdOutError(st.env, x.segment, st.fits[j], options.fit));
+          m = std::min(m, holdOutError(st.env, x.segment, st.fits[j], options));
       cv_laws = m;
     }
     cv_rival = *cv_laws;
@@ -547,13 +537,14 @@ bool confirmCandidate(ExplainState& st, HoldOutRivals* rivals, int k) {
   s.hold_out_reference = cv_rival;
   // A beat or a two-stage decay (4 parameters more than the line, a searched split) must
   // predict held-out blocks 10 % better than its rival; an amplitude law (1 more) just better.
-  const double factor = isAmplitudeLaw(s.added) ? kHoldOutFactorLaw : kHoldOutFactorExtension;
+  const double factor =
+      isAmplitudeLaw(s.added) ? options.hold_out_factor_amplitude : options.hold_out_factor_shape;
   if (!(s.hold_out_error < factor * cv_rival)) {
     s.note = "not confirmed on hold-out (blocked two-fold prediction error " +
              fmt(s.hold_out_error) + " vs " + fmt(cv_rival) + ")";
     return false;
   }
-  if (!isAmplitudeLaw(s.added)) {
+  if (ringdownLaw(s.added).q_checked_against_baseline) {
     const auto qe = st.fits[k].derived.find("Q"), ql = x.baseline.derived.find("Q");
     if (qe != st.fits[k].derived.end() && ql != x.baseline.derived.end()) {
       const double ratio = qe->second.value / ql->second.value;
@@ -647,7 +638,7 @@ void screenNegativeLaw(ExplainState& st) {
     if (d.size() != x.baseline.fitted.size()) break;
     for (size_t i = 0; i < d.size(); ++i) d[i] = st.fits[k].fitted[i] - x.baseline.fitted[i];
     x.negative_law_rate_variation =
-        curveRateVariation(st.fits[k].t_s, d, meanDecayRate(x.baseline));
+        curveRateVariation(st.fits[k].t_s, d, meanDecayRate(x.baseline), st.options.lack_of_fit);
     if (!(x.negative_law_rate_variation > st.options.rate_variation)) st.negative_law.clear();
   }
 }
@@ -658,14 +649,14 @@ bool judgeFinalFit(ExplainState& st, const RingdownStep* pick) {
   RingdownExplanation& x = st.x;
   const RingdownExplainOptions& options = st.options;
   requirePositiveQ(x.final_fit, x.segment);
-  addSpanSpread(st.env, x.segment, options.fit, &x.final_fit);
-  const RingdownLackOfFit lack = ringdownLackOfFit(x.final_fit);
+  addSpanSpread(st.env, x.segment, options.fit, &x.final_fit, options.span_spread);
+  const RingdownLackOfFit lack = ringdownLackOfFit(x.final_fit, options.lack_of_fit);
   x.lack_of_fit_p = lack.p_value;
   x.lack_of_fit_rate_variation = lack.rate_variation;
   x.lack_of_fit_test =
       "Wald test of Legendre P2..P5 in time added to the final model's weighted residuals, "
-      "significant under both the residuals' AR noise model and AR models fitted in 4 contiguous "
-      "blocks";
+      "significant under both the residuals' AR noise model and AR models fitted in " +
+      std::to_string(options.lack_of_fit.ar_blocks) + " contiguous blocks";
   // Unexplained only when the misfit is significant and large enough to see: a local decay rate
   // that wanders by under `rate_variation` (RMS) of the mean leaves one Q for the span (real
   // records: a floor that breathes under the decay, a detector not quite log-linear).
@@ -686,28 +677,30 @@ std::string qText(const RingdownFit& fin, const std::string& k) {
          "]";
 }
 
-/// The sentence of an accepted extension `added` with the final fit `fin`.
+/// The sentence of an accepted extension `added` with the final fit `fin`: its law's cause_text
+/// with {KEY} the derived value KEY with its interval (qText) and {KEY.value} its value alone.
 void describeExtension(std::ostringstream& cs, const std::string& added, const RingdownFit& fin) {
-  if (added == "gamma_nl")
-    cs << "Damping grows with the amplitude squared (gas or thermoelastic-like loss): Q0 = "
-       << qText(fin, "Q0") << " at zero amplitude, Q = " << qText(fin, "Q")
-       << " over the span (its mean decay rate); compare resonators by Q0 or at one "
-          "amplitude. ";
-  else if (added == "gamma_a")
-    cs << "Damping grows linearly with the amplitude (clamping or friction-like loss at the "
-          "mount): Q0 = "
-       << qText(fin, "Q0") << ", Q = " << qText(fin, "Q")
-       << " over the span (its mean decay rate); check the clamping. ";
-  else if (added == "beat")
-    cs << "Two close modes beat in this channel: split "
-       << fmt(fin.derived.at("frequency_split_hz").value) << " Hz, Q1 = " << qText(fin, "Q_mode1")
-       << ", Q2 = " << qText(fin, "Q_mode2") << " (damping anisotropy "
-       << fmt(fin.derived.at("damping_anisotropy_1_s").value)
-       << " 1/s); the degenerate pair is split: trim it, or excite along one mode axis. ";
-  else if (added == "two_stage")
-    cs << "Two-stage decay: a fast stage (Q1 = " << qText(fin, "Q_mode1")
-       << ") then the slow one (Q2 = " << qText(fin, "Q_mode2")
-       << "): a second mode or a transient after switch-off; quote Q2. ";
+  static const std::string kValueOnly = ".value";
+  const std::string text = ringdownLaw(added).cause_text;
+  size_t at = 0;
+  while (at < text.size()) {
+    const size_t open = text.find('{', at);
+    const size_t close = open == std::string::npos ? open : text.find('}', open);
+    if (close == std::string::npos) {
+      cs << text.substr(at);
+      break;
+    }
+    cs << text.substr(at, open - at);
+    const std::string key = text.substr(open + 1, close - open - 1);
+    const bool value_only =
+        key.size() > kValueOnly.size() &&
+        key.compare(key.size() - kValueOnly.size(), std::string::npos, kValueOnly) == 0;
+    if (value_only)
+      cs << fmt(fin.derived.at(key.substr(0, key.size() - kValueOnly.size())).value);
+    else
+      cs << qText(fin, key);
+    at = close + 1;
+  }
 }
 
 /// 10. Causes and the sentence.

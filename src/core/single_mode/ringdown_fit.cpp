@@ -20,46 +20,12 @@ namespace {
 
 /// The law whose weighted straight line starts every fit (and gives the others' starts).
 constexpr char kBaselineLaw[] = "linear";
-/// Samples a fit needs beyond its parameter count.
-constexpr int kMinSamplesOverParameters = 4;
 /// Guard of the time scale T against a span of one time.
 constexpr double kMinTimeScale = 1e-300;
-/// A_ref is the median level of the span's first this many samples.
-constexpr size_t kReferenceSamples = 5;
-/// Error model: bins of the scatter estimate, at least / at most, and samples per bin aimed at.
-constexpr int kMinScatterBins = 2;
-constexpr int kMaxScatterBins = 8;
-constexpr int kSamplesPerScatterBin = 12;
-/// Error model: a bin with fewer samples than this gives no scatter.
-constexpr int kMinSamplesInScatterBin = 6;
 /// Guard of a bin's normalized half-width (time axis of its local fit).
 constexpr double kMinBinHalfWidth = 1e-12;
 /// Smallest variance a bin reads.
 constexpr double kMinBinVariance = 1e-30;
-/// auto error model: additive when the additive variance at the lowest bin level exceeds this times
-/// the log-scale one ...
-constexpr double kAdditiveOverLogVariance = 1.0;
-/// ... and the last bin's variance this times the first one's (or a floor is known).
-constexpr double kAdditiveScatterGrowth = 2.0;
-/// Additive error model: the log-scale variance is at least this fraction of the quietest bin's.
-constexpr double kMinLogVarianceFraction = 0.25;
-/// Weights: half-width of the running mean of the level (5 points).
-constexpr int kLevelMeanHalfWidth = 2;
-/// Weights at a smooth level: more samples than this, under the additive error model only.
-constexpr int kMinSamplesForSmoothLevel = 40;
-/// Weights at a smooth level: half-width of the window bounding it, at least this ...
-constexpr int kMinLevelBoundHalfWidth = 10;
-/// ... or the number of samples over this.
-constexpr int kLevelBoundWindowsPerSpan = 32;
-/// Weights at a smooth level: refits with the new weights, and the Legendre degree.
-constexpr int kSmoothLevelPasses = 2;
-constexpr int kSmoothLevelDegree = 6;
-/// Q against amplitude: automatic bins at most, dB of fitted drop per bin, samples per bin aimed
-/// at, and the fewest a bin is fitted with.
-constexpr double kMaxAutoQBins = 8.0;
-constexpr double kDbPerQBin = 3.0;
-constexpr int kSamplesPerQBin = 12;
-constexpr int kMinSamplesInQBin = 10;
 
 const double kInf = std::numeric_limits<double>::infinity();
 
@@ -97,18 +63,18 @@ bool jacobian(const RingdownLaw& law, const Eigen::VectorXd& p, const Data& d, d
 /// Step 1: the span's usable samples (no dropout, finite level) and the normalization they give:
 /// t_ref, t_scale, log_a_ref (median of the first levels) and floor_rel.
 std::vector<size_t> normalizeSpan(const RingdownEnvelope& env, const RingdownSegment& seg,
-                                  RingdownFit& fit) {
+                                  const RingdownFitOptions& options, RingdownFit& fit) {
   std::vector<size_t> used;
   for (size_t i = seg.i_start; i < seg.i_end; ++i)
     if (!seg.dropout[i] && std::isfinite(env.log_amplitude[i])) used.push_back(i);
-  if (used.size() < fit.names.size() + kMinSamplesOverParameters)
+  if (used.size() < fit.names.size() + options.min_samples_over_parameters)
     throw AnalysisError("ring-down: " + std::to_string(used.size()) + " samples in the span for " +
                         std::to_string(fit.names.size()) + " parameters of model " + fit.model);
   fit.t_ref_s = env.t_s[used.front()];
   fit.t_scale_s = std::max(env.t_s[used.back()] - fit.t_ref_s, kMinTimeScale);
   {
     std::vector<double> first;
-    for (size_t i = 0; i < std::min<size_t>(used.size(), kReferenceSamples); ++i)
+    for (size_t i = 0; i < std::min<size_t>(used.size(), options.reference_samples); ++i)
       first.push_back(env.log_amplitude[used[i]]);
     fit.log_a_ref = median(first);
   }
@@ -134,7 +100,7 @@ Data fittedSamples(const RingdownEnvelope& env, const RingdownFitOptions& option
     used.swap(kept);
   }
   const int n = static_cast<int>(used.size());
-  if (n < static_cast<int>(fit.names.size()) + kMinSamplesOverParameters)
+  if (n < static_cast<int>(fit.names.size()) + options.min_samples_over_parameters)
     throw AnalysisError("ring-down: " + std::to_string(n) + " samples fitted for " +
                         std::to_string(fit.names.size()) + " parameters of model " + fit.model);
   Data d;
@@ -152,13 +118,14 @@ struct ScatterBins {
   std::vector<double> var, lvl;
 };
 
-ScatterBins scatterBins(const Data& d) {
+ScatterBins scatterBins(const Data& d, const RingdownFitOptions& options) {
   const int n = static_cast<int>(d.t.size());
-  const int nb = std::max(kMinScatterBins, std::min(kMaxScatterBins, n / kSamplesPerScatterBin));
+  const int nb = std::max(options.min_scatter_bins,
+                          std::min(options.max_scatter_bins, n / options.samples_per_scatter_bin));
   ScatterBins bins;
   for (int b = 0; b < nb; ++b) {
     const int lo = b * n / nb, hi = (b + 1) * n / nb;
-    if (hi - lo < kMinSamplesInScatterBin) continue;
+    if (hi - lo < options.min_samples_in_scatter_bin) continue;
     Eigen::MatrixXd Xq(hi - lo, 3);
     Eigen::VectorXd Yq(hi - lo);
     const double tm = 0.5 * (d.t(lo) + d.t(hi - 1)),
@@ -235,7 +202,7 @@ struct ErrorModel {
 /// sample-to-sample differences, which correlated detector noise makes small): var = s_m^2 +
 /// s_a^2 exp(-2 level). Sets fit.error_model and its why.
 ErrorModel chooseErrorModel(const Data& d, const RingdownFitOptions& options, RingdownFit& fit) {
-  const ScatterBins bins = scatterBins(d);
+  const ScatterBins bins = scatterBins(d, options);
   const std::vector<double>&var_k = bins.var, &lvl_k = bins.lvl;
   const NoiseTerms terms = fitNoiseTerms(bins);
   double s_m2 = terms.s_m2, s_a2 = terms.s_a2;
@@ -251,8 +218,8 @@ ErrorModel chooseErrorModel(const Data& d, const RingdownFitOptions& options, Ri
   const double add_low = s_a2 * std::exp(-2.0 * lvl_low);
   const bool additive =
       options.error_model == "additive" ||
-      (options.error_model == "auto" && add_low > kAdditiveOverLogVariance * s_m2 &&
-       ((var_k.size() >= 2 && var_k.back() > kAdditiveScatterGrowth * var_k.front()) ||
+      (options.error_model == "auto" && add_low > options.additive_over_log_variance * s_m2 &&
+       ((var_k.size() >= 2 && var_k.back() > options.additive_scatter_growth * var_k.front()) ||
         s_a2_floor > 0.0));
   fit.error_model = additive ? "additive" : "log";
   fit.error_model_why = describeErrorModel(options, bins, additive, floor_sets_noise);
@@ -261,7 +228,8 @@ ErrorModel chooseErrorModel(const Data& d, const RingdownFitOptions& options, Ri
   // the weights grow as A^2 and the first samples (a fast first stage, a corner) outweigh the
   // rest of the decay by orders of magnitude. A quarter of the quietest bin's scatter bounds it.
   if (additive && !var_k.empty())
-    s_m2 = std::max(s_m2, kMinLogVarianceFraction * *std::min_element(var_k.begin(), var_k.end()));
+    s_m2 = std::max(
+        s_m2, options.min_log_variance_fraction * *std::min_element(var_k.begin(), var_k.end()));
   if (s_m2 <= 0.0 && s_a2 <= 0.0) s_m2 = 1.0;
   ErrorModel em;
   em.s_m2 = s_m2, em.s_a2 = s_a2, em.additive = additive;
@@ -269,13 +237,13 @@ ErrorModel chooseErrorModel(const Data& d, const RingdownFitOptions& options, Ri
 }
 
 /// Weights at the 5-point running mean of the level.
-void weighAtRunningMean(const ErrorModel& em, Data& d) {
+void weighAtRunningMean(const ErrorModel& em, const RingdownFitOptions& options, Data& d) {
   const int n = static_cast<int>(d.t.size());
   for (int i = 0; i < n; ++i) {
     double acc = 0;
     int c = 0;
-    for (int j = std::max(0, i - kLevelMeanHalfWidth);
-         j <= std::min(n - 1, i + kLevelMeanHalfWidth); ++j)
+    for (int j = std::max(0, i - options.level_mean_half_width);
+         j <= std::min(n - 1, i + options.level_mean_half_width); ++j)
       acc += d.y(j), ++c;
     const double lvl = acc / c;
     d.w(i) = 1.0 / (em.s_m2 + em.s_a2 * std::exp(-2.0 * lvl));
@@ -287,16 +255,17 @@ void weighAtRunningMean(const ErrorModel& em, Data& d) {
 // additive noise (Q 1-5 % high). The level for the weights is therefore a smooth of the whole
 // span instead: a weighted Legendre polynomial of degree 6 in time (leverage 7 / n per sample),
 // refitted once with its own weights. The same for every model, so criteria compare.
-void weighAtSmoothLevel(const ErrorModel& em, Data& d) {
+void weighAtSmoothLevel(const ErrorModel& em, const RingdownFitOptions& options, Data& d) {
   const int n = static_cast<int>(d.t.size());
-  const int half = std::max(kMinLevelBoundHalfWidth, n / kLevelBoundWindowsPerSpan);
+  const int half =
+      std::max(options.min_level_bound_half_width, n / options.level_bound_windows_per_span);
   Eigen::VectorXd y_lo(n), y_hi(n);
   for (int i = 0; i < n; ++i) {
     const int a = std::max(0, i - half), len = std::min(n - 1, i + half) - a + 1;
     y_lo(i) = d.y.segment(a, len).minCoeff(), y_hi(i) = d.y.segment(a, len).maxCoeff();
   }
-  for (int pass = 0; pass < kSmoothLevelPasses; ++pass) {
-    const int deg = kSmoothLevelDegree;
+  for (int pass = 0; pass < options.smooth_level_passes; ++pass) {
+    const int deg = options.smooth_level_degree;
     Eigen::MatrixXd X(n, deg + 1);
     Eigen::VectorXd Y(n);
     for (int i = 0; i < n; ++i) {
@@ -321,10 +290,10 @@ void weighAtSmoothLevel(const ErrorModel& em, Data& d) {
 
 /// Step 4: weights 1 / var at a smoothed level, fixed during the fit, normalized to mean 1 (sigma
 /// then reads in units of the mean sd).
-void setWeights(const ErrorModel& em, Data& d) {
+void setWeights(const ErrorModel& em, const RingdownFitOptions& options, Data& d) {
   const int n = static_cast<int>(d.t.size());
-  weighAtRunningMean(em, d);
-  if (em.additive && n > kMinSamplesForSmoothLevel) weighAtSmoothLevel(em, d);
+  weighAtRunningMean(em, options, d);
+  if (em.additive && n > options.min_samples_for_smooth_level) weighAtSmoothLevel(em, options, d);
   d.w /= d.w.mean();
 }
 
@@ -473,8 +442,9 @@ void storeQVsAmplitude(const Data& d, const RingdownFitOptions& options, Ringdow
   const double drop_db = (fit.fitted.front() - fit.fitted.back()) * kDbPerNeper;
   int bins = options.q_bins > 0
                  ? options.q_bins
-                 : static_cast<int>(std::min(kMaxAutoQBins, std::floor(drop_db / kDbPerQBin)));
-  bins = std::min(bins, n / kSamplesPerQBin);
+                 : static_cast<int>(std::min(options.max_auto_q_bins,
+                                             std::floor(drop_db / options.db_per_q_bin)));
+  bins = std::min(bins, n / options.samples_per_q_bin);
   if (bins >= 2 && fit.frequency_hz > 0.0) {
     const double l0 = fit.fitted.front(), l1 = fit.fitted.back();
     int i = 0;
@@ -482,7 +452,7 @@ void storeQVsAmplitude(const Data& d, const RingdownFitOptions& options, Ringdow
       const double edge = l0 + (l1 - l0) * (b + 1) / bins;
       std::vector<int> idx;
       while (i < n && (b == bins - 1 || fit.fitted[i] >= edge)) idx.push_back(i++);
-      if (static_cast<int>(idx.size()) < kMinSamplesInQBin) continue;
+      if (static_cast<int>(idx.size()) < options.min_samples_in_q_bin) continue;
       fit.q_vs_amplitude.push_back(qBin(d, idx, options, qc, fit));
     }
   }
@@ -523,11 +493,11 @@ RingdownFit fitRingdown(const RingdownEnvelope& env, const RingdownSegment& seg,
   fit.names = law.parameters;
   fit.frequency_hz = env.frequency_hz;
   // 1-2. The span's samples, normalized; the held-out ones left out.
-  std::vector<size_t> used = normalizeSpan(env, seg, fit);
+  std::vector<size_t> used = normalizeSpan(env, seg, options, fit);
   Data d = fittedSamples(env, options, fit, used);
   const int n = static_cast<int>(used.size());
   // 3-4. Error model and weights.
-  setWeights(chooseErrorModel(d, options, fit), d);
+  setWeights(chooseErrorModel(d, options, fit), options, d);
   // 5. Fit from each starting point, the best kept.
   const double best = fitBestStart(law, startingPoints(env, seg, law, options, starts, d), d, fit);
   // 6. Canonical order, residual summaries.

@@ -114,6 +114,11 @@ void linearReadout(const RingdownReadout& r) {
   if (g.value < 0.0) r.fit.flags.push_back("negative_damping");
 }
 
+/// The baseline is never a candidate: no check.
+std::string linearPhysicalCheck(const Eigen::VectorXd&, const RingdownPlausibilityOptions&) {
+  return "";
+}
+
 RingdownLaw linearLaw() {
   RingdownLaw law;
   law.name = "linear";
@@ -123,6 +128,8 @@ RingdownLaw linearLaw() {
   law.starts = linearStarts;
   law.canonical_order = keepOrder;
   law.readout = linearReadout;
+  law.kind = RingdownLawKind::kBaseline;
+  law.physical_check = linearPhysicalCheck;
   return law;
 }
 
@@ -173,6 +180,16 @@ void amplitudeDependentReadout(const RingdownReadout& r, bool sq) {
   if (gn.value < 0.0) fit.flags.push_back("negative_amplitude_dependent_damping");
 }
 
+/// Sign check of gamma_nl and gamma_a: both dampings positive.
+std::string amplitudeDependentPhysicalCheck(const Eigen::VectorXd& p,
+                                            const RingdownPlausibilityOptions&) {
+  if (p(1) <= 0.0) return "zero-amplitude damping g0 fitted negative";
+  if (p(2) <= 0.0)
+    return "amplitude-dependent damping fitted negative (decay accelerates as the amplitude "
+           "falls: no physical damping law)";
+  return "";
+}
+
 bool gammaNlLogAmplitude(const Eigen::VectorXd& p, double t, double& log_a) {
   const double den = 1.0 + 2.0 * p(2) * std::exp(2.0 * p(0)) * oneMinusExpOver(2.0 * p(1), t);
   if (!(den > 0.0)) return false;
@@ -197,6 +214,13 @@ RingdownLaw gammaNlLaw() {
   law.starts = gammaNlStarts;
   law.canonical_order = keepOrder;
   law.readout = gammaNlReadout;
+  law.kind = RingdownLawKind::kAmplitudeLaw;
+  law.amplitude_power = 2;
+  law.physical_check = amplitudeDependentPhysicalCheck;
+  law.cause_text =
+      "Damping grows with the amplitude squared (gas or thermoelastic-like loss): Q0 = {Q0} at "
+      "zero amplitude, Q = {Q} over the span (its mean decay rate); compare resonators by Q0 or "
+      "at one amplitude. ";
   return law;
 }
 
@@ -224,6 +248,12 @@ RingdownLaw gammaALaw() {
   law.starts = gammaAStarts;
   law.canonical_order = keepOrder;
   law.readout = gammaAReadout;
+  law.kind = RingdownLawKind::kAmplitudeLaw;
+  law.amplitude_power = 1;
+  law.physical_check = amplitudeDependentPhysicalCheck;
+  law.cause_text =
+      "Damping grows linearly with the amplitude (clamping or friction-like loss at the mount): "
+      "Q0 = {Q0}, Q = {Q} over the span (its mean decay rate); check the clamping. ";
   return law;
 }
 
@@ -385,6 +415,16 @@ void beatReadout(const RingdownReadout& r) {
   twoModeReadout(r, true);
 }
 
+/// Sign check of the beat: both rates positive, two beat periods in the span, a second mode that
+/// is not negligible.
+std::string beatPhysicalCheck(const Eigen::VectorXd& p, const RingdownPlausibilityOptions& o) {
+  if (p(1) <= 0.0 || p(3) <= 0.0) return "a mode's decay rate fitted negative";
+  if (p(4) < o.beat_min_split_w) return "under two beat periods in the span (a step is not a beat)";
+  if (p(2) - p(0) < std::log(o.beat_min_amplitude_ratio))
+    return "second mode below 0.5 % of the first";
+  return "";
+}
+
 RingdownLaw beatLaw() {
   RingdownLaw law;
   law.name = "beat";
@@ -394,6 +434,14 @@ RingdownLaw beatLaw() {
   law.starts = beatStarts;
   law.canonical_order = beatCanonicalOrder;
   law.readout = beatReadout;
+  law.kind = RingdownLawKind::kShapeAlternative;
+  law.searched_frequency = true;
+  law.q_checked_against_baseline = true;
+  law.physical_check = beatPhysicalCheck;
+  law.cause_text =
+      "Two close modes beat in this channel: split {frequency_split_hz.value} Hz, Q1 = {Q_mode1}, "
+      "Q2 = {Q_mode2} (damping anisotropy {damping_anisotropy_1_s.value} 1/s); the degenerate "
+      "pair is split: trim it, or excite along one mode axis. ";
   return law;
 }
 
@@ -429,6 +477,13 @@ void twoStageReadout(const RingdownReadout& r) {
   twoModeReadout(r, false);
 }
 
+/// Sign check of the two-stage decay: both rates positive, the stages' rates apart.
+std::string twoStagePhysicalCheck(const Eigen::VectorXd& p, const RingdownPlausibilityOptions& o) {
+  if (p(1) <= 0.0 || p(3) <= 0.0) return "a stage's decay rate fitted negative";
+  if (p(1) < o.two_stage_min_rate_ratio * p(3)) return "the two stages' rates differ by under 1.5x";
+  return "";
+}
+
 RingdownLaw twoStageLaw() {
   RingdownLaw law;
   law.name = "two_stage";
@@ -438,6 +493,12 @@ RingdownLaw twoStageLaw() {
   law.starts = twoStageStarts;
   law.canonical_order = twoStageCanonicalOrder;
   law.readout = twoStageReadout;
+  law.kind = RingdownLawKind::kShapeAlternative;
+  law.q_checked_against_baseline = true;
+  law.physical_check = twoStagePhysicalCheck;
+  law.cause_text =
+      "Two-stage decay: a fast stage (Q1 = {Q_mode1}) then the slow one (Q2 = {Q_mode2}): a "
+      "second mode or a transient after switch-off; quote Q2. ";
   return law;
 }
 
@@ -449,10 +510,15 @@ const std::vector<RingdownLaw>& ringdownLaws() {
   return laws;
 }
 
+const RingdownLaw* findRingdownLaw(const std::string& name) {
+  for (const RingdownLaw& law : ringdownLaws())
+    if (name == law.name) return &law;
+  return nullptr;
+}
+
 const RingdownLaw& ringdownLaw(const std::string& name) {
+  if (const RingdownLaw* law = findRingdownLaw(name)) return *law;
   const std::vector<RingdownLaw>& laws = ringdownLaws();
-  for (const RingdownLaw& law : laws)
-    if (name == law.name) return law;
   std::string known;
   for (size_t k = 0; k < laws.size(); ++k)
     known += (k == 0 ? "" : k + 1 == laws.size() ? " or " : ", ") + std::string(laws[k].name);

@@ -8,9 +8,10 @@
 namespace cvg_bench {
 
 void addSpanSpread(const RingdownEnvelope& env, const RingdownSegment& seg,
-                   const RingdownFitOptions& options, RingdownFit* fit) {
+                   const RingdownFitOptions& options, RingdownFit* fit,
+                   const RingdownSpanSpreadOptions& spread) {
   const size_t len = seg.i_end - seg.i_start;
-  if (len < 20) return;
+  if (len < spread.min_span_samples) return;
   RingdownFitOptions o = options;
   o.q_bins = 0;
   std::vector<std::string> names;
@@ -18,8 +19,10 @@ void addSpanSpread(const RingdownEnvelope& env, const RingdownSegment& seg,
     if (fit->derived.count(k)) names.push_back(k);
   std::vector<double> sum2(names.size(), 0.0);
   int used = 0;
-  for (const auto& cut :
-       {std::pair<double, double>{0.1, 0.0}, {0.2, 0.0}, {0.0, 0.1}, {0.0, 0.2}}) {
+  for (const auto& cut : {std::pair<double, double>{spread.near_cut, 0.0},
+                          {spread.far_cut, 0.0},
+                          {0.0, spread.near_cut},
+                          {0.0, spread.far_cut}}) {
     RingdownSegment s = seg;
     s.i_start = seg.i_start + static_cast<size_t>(cut.first * len);
     s.i_end = seg.i_end - static_cast<size_t>(cut.second * len);
@@ -38,8 +41,8 @@ void addSpanSpread(const RingdownEnvelope& env, const RingdownSegment& seg,
       // A neighbouring span that does not fit adds nothing; at least three are needed.
     }
   }
-  if (used < 3) return;
-  const double z = 1.959963984540054;
+  if (used < spread.min_fits) return;
+  const double z = spread.z;
   for (size_t k = 0; k < names.size(); ++k) {
     RingdownValue& v = fit->derived[names[k]];
     v.std_span = std::sqrt(sum2[k] / used);

@@ -40,6 +40,66 @@ struct RingdownFitOptions {
   std::vector<bool> hold_out;
   /// false: parameters and residuals only (no covariance, no Q against amplitude).
   bool details = true;
+
+  // ---- tuned values (every one set by hand; the commit named is where the value first appears)
+  /// A fit needs at least this many samples beyond its parameter count [samples] (fewer:
+  /// AnalysisError). Commit 2cc791c, no recorded evidence.
+  int min_samples_over_parameters = 4;
+  /// A_ref is the median level of the span's first this many samples [samples]. Commit 2cc791c,
+  /// no recorded evidence.
+  size_t reference_samples = 5;
+  /// Error model: the span's scatter is measured in time bins, at least this many ... Commit
+  /// 3dbfdf5, no recorded evidence.
+  int min_scatter_bins = 2;
+  /// ... at most this many ("eight time bins" of the file comment). Commit 3dbfdf5, no recorded
+  /// evidence.
+  int max_scatter_bins = 8;
+  /// ... aiming at this many samples per bin [samples]. Commit 3dbfdf5, no recorded evidence.
+  int samples_per_scatter_bin = 12;
+  /// A bin with fewer samples gives no scatter [samples]. Commit ca46f02 (scatter about local
+  /// quadratics, since correlated noise hid in differences), no recorded evidence for 6.
+  int min_samples_in_scatter_bin = 6;
+  /// "auto" error model: additive when the additive variance at the lowest bin level exceeds this
+  /// times the log-scale one [1] ... Commit 3dbfdf5, no recorded evidence.
+  double additive_over_log_variance = 1.0;
+  /// ... and the last bin's variance exceeds this times the first one's (or a floor is known) [1].
+  /// Commit 3dbfdf5, no recorded evidence.
+  double additive_scatter_growth = 2.0;
+  /// Additive error model: the log-scale variance is at least this fraction of the quietest bin's
+  /// [1]. With it at zero the weights grew as A^2 and a two_stage record's first samples
+  /// outweighed the rest by 1e14 (commit 52cf922; docs/validation_ringdown.md); no recorded
+  /// evidence for a quarter.
+  double min_log_variance_fraction = 0.25;
+  /// Weights: half-width of the running mean of the level [samples] (5 points). Commit 3dbfdf5,
+  /// no recorded evidence.
+  int level_mean_half_width = 2;
+  /// Weights at a smooth level (additive error model only) for more samples than this [samples].
+  /// Commit 06f667e (mean z of Q on floor records +0.65 -> +0.3 for the smooth level), no
+  /// recorded evidence for 40.
+  int min_samples_for_smooth_level = 40;
+  /// Smooth level: held within the observed levels over a window of half-width at least this
+  /// [samples] ... Commit 52cf922 (docs/validation_ringdown.md: a polynomial through a fast
+  /// first stage's corner overshot), no recorded evidence for 10.
+  int min_level_bound_half_width = 10;
+  /// ... or the number of samples over this [1]. Commit 52cf922, no recorded evidence.
+  int level_bound_windows_per_span = 32;
+  /// Smooth level: fits of the level, each with the previous one's weights [1]. Commit 06f667e,
+  /// no recorded evidence.
+  int smooth_level_passes = 2;
+  /// Smooth level: degree of its Legendre polynomial in time (leverage 7 / n per sample) [1].
+  /// Commit 06f667e (Q coverage on 40 clean records 35 -> 38 for the whole change), no recorded
+  /// evidence for 6 over another degree.
+  int smooth_level_degree = 6;
+  /// Q against amplitude (q_bins = 0): automatic bins at most [1] ... Commit 3dbfdf5, no recorded
+  /// evidence.
+  double max_auto_q_bins = 8.0;
+  /// ... one per this much fitted drop [dB]. Commit 3dbfdf5, no recorded evidence.
+  double db_per_q_bin = 3.0;
+  /// ... and at most one per this many samples [samples]. Commit 3dbfdf5, no recorded evidence.
+  int samples_per_q_bin = 12;
+  /// A Q bin with fewer samples is left out [samples]. Commit 3dbfdf5, no recorded evidence.
+  int min_samples_in_q_bin = 10;
+
   std::vector<std::string> validate() const;
 };
 

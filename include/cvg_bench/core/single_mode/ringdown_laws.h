@@ -26,16 +26,19 @@
 // How to add a ring-down law: in ringdown_laws.cpp, write its pieces in one block like the others:
 // ln A'(t') without the floor (false outside its domain), its starting points from the fitted
 // linear baseline, its canonical parameter order (keepOrder when it has none), its physical readout
-// (rates in 1/s, Q, tau_s, flags, through RingdownReadout), and a function returning its
-// RingdownLaw record; add that to the table in ringdownLaws(). is_extension = true makes it a
-// candidate of the explain stage (ringdownExtensionNames, in table order). State its equation
-// above and its parameter names in ringdown_models.h, its outputs in docs/interfaces.md. The
-// unknown-name message lists the table. The fit no longer dispatches on the name; the explain
-// stage still does (ringdown_causes.cpp: signCheck, isAmplitudeLaw, the beat's penalty, the
-// causes' text), so give a new extension its branches there.
+// (rates in 1/s, Q, tau_s, flags, through RingdownReadout), its physical check (the explain
+// stage's sign check), the sentence the explanation prints when it is selected, and a function
+// returning its RingdownLaw record with its kind and flags; add that to the table in
+// ringdownLaws(). is_extension = true makes it a candidate of the explain stage
+// (ringdownExtensionNames, in table order; the default RingdownExplainOptions::candidates). State
+// its equation above and its parameter names in ringdown_models.h, its outputs in
+// docs/interfaces.md. The unknown-name message lists the table. Neither the fit nor the explain
+// stage nor the CLI dispatches on a law's name: they read the record's fields
+// (test/core/single_mode/ringdown_laws_test.cpp checks every law has them).
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -68,6 +71,35 @@ struct RingdownReadout {
   void putQ(const std::string& name, const RingdownValue& rate) const;
 };
 
+/// How the explain stage treats a law (ringdown_causes.h).
+enum class RingdownLawKind {
+  /// The single exponential every other law is compared with (not a candidate).
+  kBaseline,
+  /// Damping that depends on the amplitude: rate g0 + g A^amplitude_power, parameters {a, g0, g}
+  /// (g at index 2). Q0 at zero amplitude differs from the line's Q by design; a negative g that
+  /// wins means the decay accelerates ("unexplained"); the two such laws are compared once more
+  /// through the detector filter.
+  kAmplitudeLaw,
+  /// Another shape of the decay (two modes): it must beat every physical amplitude law by
+  /// law_margin and predict held-out blocks by the larger hold-out margin.
+  kShapeAlternative,
+};
+
+/// Thresholds of the laws' physical checks (RingdownLaw::physical_check; the explain stage's
+/// RingdownExplainOptions::plausibility).
+struct RingdownPlausibilityOptions {
+  /// beat: smallest split w [rad per span] a beat is taken for: 4 pi, two beat periods in the
+  /// span (fewer: a step is not a beat). Set by hand with "beat needs 2 periods" (commit 2cc791c),
+  /// no recorded evidence for 2.
+  double beat_min_split_w = 4.0 * M_PI;
+  /// beat: smallest amplitude ratio A2/A1 of the second mode at the span's start [1] (0.5 %).
+  /// Set by hand (commit 3dbfdf5), no recorded evidence.
+  double beat_min_amplitude_ratio = 0.005;
+  /// two_stage: the fast stage's rate at least this times the slow one's [1]. Set by hand
+  /// (commit 3dbfdf5), no recorded evidence.
+  double two_stage_min_rate_ratio = 1.5;
+};
+
 /// One ring-down law (see the file comment for the equations and how to add one).
 struct RingdownLaw {
   /// Name (--model, the extension names of docs/interfaces.md).
@@ -86,6 +118,26 @@ struct RingdownLaw {
   /// Physical values, derived values and flags of a fit with details.
   void (*readout)(const RingdownReadout& r) = nullptr;
 
+  // ---- what the explain stage (ringdown_causes.cpp) and the CLI read ----
+  /// How the explain stage treats it.
+  RingdownLawKind kind = RingdownLawKind::kBaseline;
+  /// kAmplitudeLaw: the power of A in its amplitude-dependent rate (2: A^2, 1: A), which names the
+  /// generator's coefficient it is simulated with (cvg_ident simulate --effect); 0 otherwise.
+  int amplitude_power = 0;
+  /// Its split frequency is searched (a periodogram over the span): its information criterion
+  /// pays for the search beyond its parameters (RingdownExplainOptions::split_search_penalty).
+  bool searched_frequency = false;
+  /// An accepted fit must have its Q within RingdownExplainOptions::q_factor of the single
+  /// exponential's over the same span (else it describes something else than the decay).
+  bool q_checked_against_baseline = false;
+  /// Sign check of fitted normalized parameters: "" when physical, else why not.
+  std::string (*physical_check)(const Eigen::VectorXd& p,
+                                const RingdownPlausibilityOptions& o) = nullptr;
+  /// The sentence of the explanation when it is selected, a template: {KEY} prints the final
+  /// fit's derived value KEY with its interval ("n/a (no frequency)" when absent), {KEY.value} its
+  /// value alone. Ends with a space. Empty for the baseline.
+  const char* cause_text = "";
+
   /// ln A'(t') plus the floor F' (>= 0) in power (Rice mean); NaN where log_amplitude is false.
   double logAmplitude(const Eigen::VectorXd& p, double t, double floor_rel) const;
 };
@@ -95,6 +147,9 @@ const std::vector<RingdownLaw>& ringdownLaws();
 
 /// The law of that name; InputError for an unknown name (the message lists the known ones).
 const RingdownLaw& ringdownLaw(const std::string& name);
+
+/// The law of that name, nullptr for an unknown name.
+const RingdownLaw* findRingdownLaw(const std::string& name);
 
 /// Q = c / rate. The interval is the delta method on ln Q = ln c - ln rate (sd of ln Q = the
 /// rate's relative sd), with the rate's own quantile: positive and of nonzero width for every
