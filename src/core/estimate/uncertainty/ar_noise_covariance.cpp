@@ -8,11 +8,16 @@
 namespace cvg_bench {
 namespace {
 
-constexpr int kMaxArOrder = 12;
-constexpr int kLjungBoxLags = 10;
-constexpr int kBlocks = 16;
+// The tuned settings are ArNoiseOptions' fields (ar_noise_covariance.h); what stays here is
+// numerical: the impulse response's length cap and tail, and the repair of a non-stationary fit.
 
-ArNoiseCovariance arNoiseCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r);
+/// A non-stationary block AR fit (arNoiseCovarianceLocal) is shrunk by this factor per round, at
+/// most kStationaryShrinkRounds rounds, until its autocorrelation is finite (a numerical repair).
+constexpr double kStationaryShrink = 0.9;
+constexpr int kStationaryShrinkRounds = 40;
+
+ArNoiseCovariance arNoiseCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
+                                         const ArNoiseOptions& o);
 
 /// Autocorrelations r_1..r_L of x (mean removed).
 std::vector<double> autocorrelation(const Eigen::VectorXd& x, int lags) {
@@ -74,10 +79,10 @@ std::vector<double> arAutocorrelation(const std::vector<double>& a, int max_lag)
 /// Step 4 of the header: each parameter keeps the larger of its standard errors under `out` and
 /// under the cluster sandwich of B contiguous blocks of the scores.
 void blockCheck(const Eigen::MatrixXd& J, const Eigen::VectorXd& r, const Eigen::MatrixXd& jtj_inv,
-                ArNoiseCovariance& out) {
+                const ArNoiseOptions& o, ArNoiseCovariance& out) {
   const int n = static_cast<int>(J.rows()), p = static_cast<int>(J.cols());
-  const int B = std::min(kBlocks, n / 10);
-  if (B < p + 4 || out.rank < p) return;
+  const int B = std::min(o.check_blocks, n / o.check_block_min_samples);
+  if (B < p + o.check_min_df || out.rank < p) return;
   Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(p, p);
   for (int b = 0; b < B; ++b) {
     const int lo = b * n / B, hi = (b + 1) * n / B;
@@ -110,8 +115,8 @@ void blockCheck(const Eigen::MatrixXd& J, const Eigen::VectorXd& r, const Eigen:
 }  // namespace
 
 ArNoiseCovariance arNoiseCovariance(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
-                                    bool block_check) {
-  ArNoiseCovariance out = arNoiseCovarianceModel(J, r);
+                                    bool block_check, const ArNoiseOptions& options) {
+  ArNoiseCovariance out = arNoiseCovarianceModel(J, r, options);
   if (!block_check) return out;
   Eigen::MatrixXd jtj_inv = Eigen::MatrixXd::Zero(J.cols(), J.cols());
   if (out.rank == J.cols()) {
@@ -121,13 +126,14 @@ ArNoiseCovariance arNoiseCovariance(const Eigen::MatrixXd& J, const Eigen::Vecto
         R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(J.cols(), J.cols()));
     jtj_inv = Rinv * Rinv.transpose();
   }
-  blockCheck(J, r, jtj_inv, out);
+  blockCheck(J, r, jtj_inv, options, out);
   return out;
 }
 
 namespace {
 
-ArNoiseCovariance arNoiseCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r) {
+ArNoiseCovariance arNoiseCovarianceModel(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
+                                         const ArNoiseOptions& o) {
   ArNoiseCovariance out;
   const int n = static_cast<int>(J.rows()), p = static_cast<int>(J.cols());
   Eigen::HouseholderQR<Eigen::MatrixXd> hq(J);
@@ -146,33 +152,34 @@ ArNoiseCovariance arNoiseCovarianceModel(const Eigen::MatrixXd& J, const Eigen::
   out.effective_n = n;
   out.student_df = n - p;
 
-  const std::vector<double> rc = autocorrelation(r, kLjungBoxLags);
+  const std::vector<double> rc = autocorrelation(r, o.ljung_box_lags);
   out.rho1 = rc[1];
   double q = 0.0;
-  for (int l = 1; l <= kLjungBoxLags && l < n; ++l) q += rc[l] * rc[l] / (n - l);
+  for (int l = 1; l <= o.ljung_box_lags && l < n; ++l) q += rc[l] * rc[l] / (n - l);
   q *= n * (n + 2.0);
   out.ljung_box_p = boost::math::cdf(
-      boost::math::complement(boost::math::chi_squared(kLjungBoxLags), std::max(q, 0.0)));
-  out.correlated =
-      std::fabs(out.rho1) > 2.576 / std::sqrt(static_cast<double>(n)) || out.ljung_box_p < 0.01;
+      boost::math::complement(boost::math::chi_squared(o.ljung_box_lags), std::max(q, 0.0)));
+  out.correlated = std::fabs(out.rho1) > o.lag1_band_z / std::sqrt(static_cast<double>(n)) ||
+                   out.ljung_box_p < o.ljung_box_level;
   std::ostringstream m;
   m.precision(3);
-  if (!out.correlated || n < 4 * kMaxArOrder + 10) {
+  if (!out.correlated || n < o.ar_min_samples_per_order * o.max_ar_order + o.ar_min_samples_extra) {
     m << "white-noise (Cramer-Rao) covariance of the weighted ln A residuals: no serial "
          "correlation detected (lag-1 "
       << out.rho1 << ", Ljung-Box p " << out.ljung_box_p << ")";
     out.method = m.str();
     return out;
   }
-  // AR order by BIC on a common sample (the first kMaxArOrder values dropped).
+  // AR order by BIC on a common sample (the first max_ar_order values dropped).
   const Eigen::VectorXd x = r.array() - r.mean();
+  const int max_order = o.max_ar_order;
   int best_p = 1;
   double best_bic = std::numeric_limits<double>::infinity();
-  for (int k = 1; k <= kMaxArOrder; ++k) {
+  for (int k = 1; k <= max_order; ++k) {
     double v = 0.0;
-    fitAr(x.tail(n - (kMaxArOrder - k)), k, v);
-    const double bic = (n - kMaxArOrder) * std::log(std::max(v, 1e-300)) +
-                       k * std::log(static_cast<double>(n - kMaxArOrder));
+    fitAr(x.tail(n - (max_order - k)), k, v);
+    const double bic = (n - max_order) * std::log(std::max(v, 1e-300)) +
+                       k * std::log(static_cast<double>(n - max_order));
     if (bic < best_bic) best_bic = bic, best_p = k;
   }
   double innov = 0.0;
@@ -182,7 +189,7 @@ ArNoiseCovariance arNoiseCovarianceModel(const Eigen::MatrixXd& J, const Eigen::
   std::vector<double> rho = arAutocorrelation(out.ar, max_lag);
   int L = 0;
   for (int l = 1; l <= max_lag; ++l) {
-    if (std::fabs(rho[l]) < 1e-4) break;
+    if (std::fabs(rho[l]) < o.autocorrelation_cutoff) break;
     L = l;
   }
   double c = 1.0;
@@ -196,7 +203,7 @@ ArNoiseCovariance arNoiseCovarianceModel(const Eigen::MatrixXd& J, const Eigen::
     rho.assign(max_lag + 1, 0.0);
     rho[0] = 1.0;
     L = 0;
-    for (int l = 1; l <= max_lag && std::fabs(std::pow(r1, l)) >= 1e-4; ++l)
+    for (int l = 1; l <= max_lag && std::fabs(std::pow(r1, l)) >= o.autocorrelation_cutoff; ++l)
       rho[l] = std::pow(r1, l), L = l;
     c = (1.0 + r1) / (1.0 - r1);
     ar1_fallback = true;
@@ -224,12 +231,12 @@ ArNoiseCovariance arNoiseCovarianceModel(const Eigen::MatrixXd& J, const Eigen::
 }  // namespace
 
 ArNoiseCovariance arNoiseCovarianceLocal(const Eigen::MatrixXd& J, const Eigen::VectorXd& r,
-                                         int blocks) {
-  ArNoiseCovariance out = arNoiseCovarianceModel(J, r);
+                                         int blocks, const ArNoiseOptions& options) {
+  ArNoiseCovariance out = arNoiseCovarianceModel(J, r, options);
   const int n = static_cast<int>(J.rows()), p = static_cast<int>(J.cols());
-  const int B = std::max(1, std::min(blocks, n / 150));
+  const int B = std::max(1, std::min(blocks, n / options.local_block_min_samples));
   if (out.rank < p || B < 2) return out;
-  // Per block: the variance and the autocorrelation of its own AR(p <= 12, BIC) model.
+  // Per block: the variance and the autocorrelation of its own AR(p <= max_ar_order, BIC) model.
   std::vector<double> var(B);
   std::vector<std::vector<double>> rho(B);
   std::vector<int> lo(B + 1);
@@ -239,7 +246,7 @@ ArNoiseCovariance arNoiseCovarianceLocal(const Eigen::MatrixXd& J, const Eigen::
     // Not centred: the block mean of slow noise is noise, not an offset to remove.
     const Eigen::VectorXd x = r.segment(lo[b], m);
     var[b] = x.squaredNorm() / m;
-    const int kmax = std::min(kMaxArOrder, m / 8);
+    const int kmax = std::min(options.max_ar_order, m / options.local_samples_per_ar_order);
     int best_p = 0;
     double best_bic = std::numeric_limits<double>::infinity();
     for (int k = 0; k <= kmax; ++k) {
@@ -254,16 +261,16 @@ ArNoiseCovariance arNoiseCovarianceLocal(const Eigen::MatrixXd& J, const Eigen::
     rho[b] = arAutocorrelation(a, m / 2);
     // A least-squares AR fit may come out non-stationary (a step inside the block): shrink the
     // coefficients until its autocorrelation is finite.
-    for (int shrink = 0; shrink < 40; ++shrink) {
+    for (int shrink = 0; shrink < kStationaryShrinkRounds; ++shrink) {
       bool finite = true;
       for (double v : rho[b]) finite &= std::isfinite(v);
       if (finite) break;
-      for (double& c : a) c *= 0.9;
+      for (double& c : a) c *= kStationaryShrink;
       rho[b] = arAutocorrelation(a, m / 2);
     }
     int L = 0;
     for (int l = 1; l < static_cast<int>(rho[b].size()); ++l) {
-      if (std::fabs(rho[b][l]) < 1e-4) break;
+      if (std::fabs(rho[b][l]) < options.autocorrelation_cutoff) break;
       L = l;
     }
     rho[b].resize(L + 1);
@@ -287,7 +294,7 @@ ArNoiseCovariance arNoiseCovarianceLocal(const Eigen::MatrixXd& J, const Eigen::
   const Eigen::MatrixXd Rinv =
       R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(p, p));
   const Eigen::MatrixXd jtj_inv = Rinv * Rinv.transpose();
-  if (!meat.allFinite()) return arNoiseCovarianceModel(J, r);
+  if (!meat.allFinite()) return arNoiseCovarianceModel(J, r, options);
   out.covariance = jtj_inv * meat * jtj_inv;
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
   std::ostringstream m;

@@ -14,7 +14,10 @@ namespace cvg_bench {
 namespace {
 
 constexpr double kRankTolerance = 1e-10;  // relative singular-value cut of the equilibrated J
-// Andrews' AR(1) plug-in diverges as rho -> 1; beyond this the fitted rho is capped (his advice).
+// Andrews' AR(1) plug-in diverges as rho -> 1; beyond this the fitted rho is capped (his advice),
+// and the VAR(1) prewhitening's singular values too so that I - A stays invertible (Andrews and
+// Monahan 1992). A numerical clamp from the literature, not a threshold tuned here: it stays a
+// constant (the HAC functions take no options struct).
 constexpr double kMaxPluginRho = 0.97;
 constexpr long kChunkRows = 4096;  // window sums folded into the meat per GEMM
 

@@ -100,5 +100,32 @@ TEST(RingdownIntervals, LocalArCovarianceIsFiniteWithAStepInABlock) {
   EXPECT_GT(c.covariance(1, 1), 0.0);
 }
 
+// The options' defaults are the values the covariance always used: passing them explicitly gives
+// the same numbers bit for bit, and a stricter detection band turns the AR model off.
+TEST(RingdownIntervals, DefaultOptionsEqualTheImplicitOnes) {
+  std::mt19937 rng(11);
+  const int n = 800;
+  Eigen::MatrixXd J(n, 2);
+  for (int i = 0; i < n; ++i) J(i, 0) = 1.0, J(i, 1) = static_cast<double>(i) / n;
+  const Eigen::VectorXd e = changingNoise(rng, n);
+  const Eigen::VectorXd res = e - J * J.colPivHouseholderQr().solve(e);
+  const ArNoiseOptions o;
+  const ArNoiseCovariance a = arNoiseCovariance(J, res), b = arNoiseCovariance(J, res, true, o);
+  EXPECT_TRUE(a.covariance == b.covariance);
+  EXPECT_EQ(a.method, b.method);
+  EXPECT_EQ(a.ljung_box_p, b.ljung_box_p);
+  const ArNoiseCovariance la = arNoiseCovarianceLocal(J, res, 4);
+  const ArNoiseCovariance lb = arNoiseCovarianceLocal(J, res, 4, o);
+  EXPECT_TRUE(la.covariance == lb.covariance);
+  EXPECT_EQ(la.method, lb.method);
+  ASSERT_TRUE(a.correlated);
+  ArNoiseOptions never;
+  never.lag1_band_z = 1e300;
+  never.ljung_box_level = 0.0;
+  const ArNoiseCovariance w = arNoiseCovariance(J, res, false, never);
+  EXPECT_FALSE(w.correlated);
+  EXPECT_TRUE(w.covariance == w.crb);
+}
+
 }  // namespace
 }  // namespace cvg_bench
