@@ -206,8 +206,6 @@ struct HonestCovariance {
   double rss = 0.0;
 };
 
-constexpr int kResidualLags = 12;  // residual correlations used to fit the AR(1) noise model
-
 void recordCorrelationTest(const SerialCorrelationTest& t, Estimate* e) {
   e->residual_lag1 = t.lag1;
   e->residual_lag1_expected = t.expected;
@@ -220,14 +218,14 @@ void recordCorrelationTest(const SerialCorrelationTest& t, Estimate* e) {
 struct ResidualPass {
   double rss = 0.0;
   long blocks = 0;
-  std::vector<double> corr;  ///< residual correlations at lags 1..kResidualLags
+  std::vector<double> corr;  ///< residual correlations at lags 1..residual_ar1_lags
   long steps = 0;
 };
 
-ResidualPass residualPass(const BlockStream& stream, const Eigen::VectorXd& z, int k,
+ResidualPass residualPass(const BlockStream& stream, const Eigen::VectorXd& z, int k, int max_lag,
                           FreeDecayNoisePropagation* propagation, Estimate* e) {
   ResidualPass out;
-  ResidualLagAccumulator lags(kResidualLags);
+  ResidualLagAccumulator lags(max_lag);
   Eigen::VectorXd env_num = Eigen::VectorXd::Zero(k);
   double env_den = 0.0;
   bool record_start = true;
@@ -262,7 +260,7 @@ NoiseCorrelation freeDecayNoiseModel(const SystemInfo& info, const SerialCorrela
     e->interval_method_id = "eiv_ar1";
     e->noise_model = "AR(1) on each slow variable, " + rho.describe() +
                      " fitted to the residual correlations at lags 1-" +
-                     std::to_string(kResidualLags);
+                     std::to_string(corr.size());
   } else {
     e->interval_method_id = "eiv_white";
     e->noise_model = "white";
@@ -283,7 +281,8 @@ Eigen::MatrixXd correlatedMeat(const BlockStream& stream, const SystemInfo& info
 /// Free decay (2.7): errors in variables, noise on q white, AR(1) (fitted to the residual
 /// correlations when the lag-1 test rejects independence) or the record's stated correlation.
 HonestCovariance freeDecayCovariance(const BlockStream& stream, const SystemInfo& info,
-                                     const SolvedSystem& s, Estimate* e) {
+                                     const SolvedSystem& s, const IdentificationOptions& opt,
+                                     Estimate* e) {
   const int k = static_cast<int>(info.names.size());
   const Eigen::VectorXd z = e->values;
   const Eigen::MatrixXd& c = s.ls.unscaled_covariance;
@@ -291,7 +290,7 @@ HonestCovariance freeDecayCovariance(const BlockStream& stream, const SystemInfo
   HonestCovariance h;
   h.dof = dof_paper;
   FreeDecayNoisePropagation propagation(*info.resonator, z);
-  const ResidualPass pass = residualPass(stream, z, k, &propagation, e);
+  const ResidualPass pass = residualPass(stream, z, k, opt.residual_ar1_lags, &propagation, e);
   h.rss = pass.rss;
   const std::vector<double>& corr = pass.corr;
   const SerialCorrelationTest test = testLagOne(corr[0], 0.0, 1.5, pass.steps);
@@ -510,7 +509,7 @@ Estimate runEstimator(const BlockStream& stream, const SystemInfo& info,
   const SolvedSystem s = solveSystem(stream, info, opt, &e);
   HonestCovariance h;
   if (info.mode == ExperimentMode::kFreeDecay && info.resonator != nullptr) {
-    h = freeDecayCovariance(stream, info, s, &e);
+    h = freeDecayCovariance(stream, info, s, opt, &e);
   } else if (info.mode == ExperimentMode::kForced) {
     h = sweepCovariance(stream, info, s, &e);
   } else {
@@ -569,6 +568,8 @@ std::vector<std::string> IdentificationOptions::validate() const {
   if (rls_init_blocks < 0) p.push_back("RLS initial blocks must be >= 0 (0 = automatic)");
   if (!(rls_forgetting > 0.0 && rls_forgetting <= 1.0))
     p.push_back("RLS forgetting factor must lie in (0, 1], got " + fmt(rls_forgetting));
+  if (residual_ar1_lags < 2)
+    p.push_back("residual AR(1) lags must be >= 2, got " + std::to_string(residual_ar1_lags));
   return p;
 }
 

@@ -123,6 +123,9 @@ TEST(FreeDecayIdentification, BadInputIsAnInputError) {
   bad.method = "magic";
   EXPECT_THROW(identifyFreeDecay(rec, bad), InputError);
   EXPECT_EQ(bad.validate().size(), 2u);
+  IdentificationOptions one_lag = opt;  // the AR(1) fit needs lags 1 and 2
+  one_lag.residual_ar1_lags = 1;
+  EXPECT_EQ(one_lag.validate().size(), 1u);
 }
 
 TEST(FreeDecayRegression, BlocksKeepTheFactorOneHalf) {
