@@ -37,6 +37,7 @@ std::vector<std::string> SelectionOptions::validate() const {
     p.push_back("min_holdout_ratio must be finite and >= 0");
   if (max_steps < 1 || max_steps > 4) p.push_back("max_steps must lie in 1..4");
   if (finalists < 1 || finalists > 20) p.push_back("finalists must lie in 1..20");
+  if (max_tried_per_finalist < 1) p.push_back("max_tried_per_finalist must be >= 1");
   if (threads < 0 || threads > 64) p.push_back("threads must lie in 0..64");
   return p;
 }
@@ -48,9 +49,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 /// Residuals per block (equation error) or per sample (output error, q has 4 components): the
 /// channels of longRunVarianceFactor.
 constexpr int kResidualChannels = 4;
-/// Finalists whose output-error fit failed are replaced by further subsets in LS order: at most
-/// this many times `finalists` subsets are tried.
-constexpr int kMaxTriedPerFinalist = 2;
 
 double ratio(double a, double b) {
   if (!(b > 0.0)) return a > 0.0 ? kInf : 1.0;
@@ -597,14 +595,16 @@ class SelectionRun {
   }
 
   /// A finalist whose output-error fit failed is not comparable: refine further subsets in LS
-  /// order until `finalists` comparable ones exist (at most twice as many tried).
+  /// order until `finalists` comparable ones exist (at most max_tried_per_finalist times as many
+  /// tried).
   void scoreFinalists(const std::vector<Terms>& finalists) {
     int comparable = 0;
     for (const auto& t : finalists)
       if (!t.empty() && std::isfinite(score(t))) ++comparable;
     int tried = static_cast<int>(finalists.size()) - 1;
     for (const auto& sc : scores_) {
-      if (comparable >= options_.finalists || tried >= kMaxTriedPerFinalist * options_.finalists)
+      if (comparable >= options_.finalists ||
+          tried >= options_.max_tried_per_finalist * options_.finalists)
         break;
       if (sc.terms.empty() || crit_.count(key(sc.terms))) continue;
       ++tried;

@@ -113,6 +113,14 @@ TEST(SubsetSelection, CleanDemodulatedRawFreeDecayIsAdequate) {
   EXPECT_NE(x.noise_model.description.find("known noise correlation"), std::string::npos);
 }
 
+TEST(SubsetSelection, OptionsValidateTheReplacementCap) {
+  SelectionOptions o;
+  EXPECT_TRUE(o.validate().empty());
+  EXPECT_EQ(o.max_tried_per_finalist, 2);
+  o.max_tried_per_finalist = 0;
+  EXPECT_EQ(o.validate().size(), 1u);
+}
+
 TEST(ResidualCorrelation, LongRunFactorOfAr1) {
   std::mt19937_64 rng(106);
   std::normal_distribution<double> normal;

@@ -98,6 +98,10 @@ struct SelectionOptions {
   /// Subsets (besides the linear model) refined by the expensive fit, best first by the LS
   /// criterion, 1..20.
   int finalists = 4;
+  /// A finalist whose output-error fit failed is replaced by further subsets in LS order, at most
+  /// max_tried_per_finalist * finalists subsets tried in all, >= 1. Set by hand (commit d229321,
+  /// which added the replacement for the Foucault record), no recorded evidence for the factor.
+  int max_tried_per_finalist = 2;
   /// Drop a term of the chosen subset when the subset without it has a better refined criterion.
   bool backward_check = true;
   /// Refined fits and hold-outs of one selection step run this many at a time, 0..64 (0: the
