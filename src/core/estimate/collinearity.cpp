@@ -12,7 +12,14 @@
 namespace cvg_bench {
 namespace {
 
-constexpr double kShownCoefficient = 0.05;  // smaller column-normalized loadings are not named
+/// Column-normalized loadings below this are not named in a weak direction's text; as
+/// analyzeIdentifiability's coefficient tolerance on the weak space it also decides which
+/// parameters enter the identified combinations reported beside the ones not identified (and drops
+/// their coefficients below it). A reporting choice: it changes what the report names and which
+/// combinations it lists, never a parameter's fitted value or interval. Set by hand (commit
+/// efb8987), no recorded evidence; the collinearity report takes no options struct, so it stays a
+/// constant here.
+constexpr double kShownCoefficient = 0.05;
 
 std::string directionText(const std::vector<std::string>& names, const Eigen::VectorXd& v) {
   std::vector<int> order(v.size());
