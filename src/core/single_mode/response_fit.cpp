@@ -37,6 +37,14 @@ constexpr double kBartlettBandwidthPoints = 100.0;
 constexpr double kBartlettBandwidthExponent = 2.0 / 9.0;
 /// Gaussian kurtosis: 3 (sum d^2)^2 / sum d^4 is the effective number of deviations d.
 constexpr double kGaussianKurtosis = 3.0;
+/// Numerical settings (not tuned thresholds): refine's Levenberg-Marquardt stops, Ceres' relative
+/// cost decrease, relative step and gradient norm.
+constexpr double kRefineFunctionTolerance = 1e-12;
+constexpr double kRefineParameterTolerance = 1e-12;
+constexpr double kRefineGradientTolerance = 1e-14;
+/// Numerical setting: jacobianAt's central-difference step, this fraction of each parameter's
+/// magnitude (at least of 1e-3 |f0| for f0 and width, of 1e-6 for the others).
+constexpr double kJacobianRelativeStep = 1e-6;
 
 /// `v` as printf's %g (the notes' numbers of options).
 std::string fmtG(double v) {
@@ -183,7 +191,9 @@ ResponseParams refine(const ResponseData& d, const Layout& L, const ResponsePara
   ceres::Problem problem;
   problem.AddResidualBlock(cost, nullptr, x.data());
   ceres::Solver::Summary s;
-  ceres::Solve(denseSolverOptions({max_iterations, 1e-12, 1e-12, 1e-14}), &problem, &s);
+  ceres::Solve(denseSolverOptions({max_iterations, kRefineFunctionTolerance,
+                                   kRefineParameterTolerance, kRefineGradientTolerance}),
+               &problem, &s);
   if (converged) *converged = s.IsSolutionUsable();
   return unpack(x.data(), L, start.f_ref_hz);
 }
@@ -217,9 +227,10 @@ double projectLinear(const ResponseData& d, const std::vector<int>& idx, double 
   return std::isfinite(rss) ? rss : std::numeric_limits<double>::infinity();
 }
 
-/// Variable projection over a grid of f0 and w (then a finer grid around the best cell).
+/// Variable projection over a grid of f0 and w (then finer grids around the best cell; the grid's
+/// sizes are ResponseFitOptions' grid_* fields).
 double gridLinear(const ResponseData& d, const std::vector<int>& idx, bool slope, double f_ref,
-                  ResponseParams* best) {
+                  const ResponseFitOptions& o, ResponseParams* best) {
   double fmin = std::numeric_limits<double>::infinity(), fmax = -fmin, step = fmax;
   for (size_t r = 0; r < idx.size(); ++r) {
     fmin = std::min(fmin, d.frequency_hz[idx[r]]);
@@ -231,12 +242,14 @@ double gridLinear(const ResponseData& d, const std::vector<int>& idx, bool slope
   }
   const double span = std::max(fmax - fmin, 1e-9 * fmax);
   if (!std::isfinite(step)) step = span;
-  double lo_f = fmin - 0.1 * span, hi_f = fmax + 0.1 * span;
-  double lo_w = std::max(0.3 * step, span * 1e-4), hi_w = 3.0 * span;
+  double lo_f = fmin - o.grid_band_margin * span, hi_f = fmax + o.grid_band_margin * span;
+  double lo_w = std::max(o.grid_min_width_steps * step, span * o.grid_min_width_band),
+         hi_w = o.grid_max_width_bands * span;
   double best_rss = std::numeric_limits<double>::infinity();
   double bf = 0.5 * (fmin + fmax), bw = std::sqrt(lo_w * hi_w);
-  for (int pass = 0; pass < 3; ++pass) {
-    const int nf = pass == 0 ? 60 : 21, nw = pass == 0 ? 30 : 21;
+  for (int pass = 0; pass < o.grid_passes; ++pass) {
+    const int nf = pass == 0 ? o.grid_first_frequencies : o.grid_later_frequencies,
+              nw = pass == 0 ? o.grid_first_widths : o.grid_later_widths;
     for (int a = 0; a < nf; ++a) {
       const double f0 = lo_f + (hi_f - lo_f) * a / (nf - 1);
       if (!(f0 > 0)) continue;
@@ -251,10 +264,14 @@ double gridLinear(const ResponseData& d, const std::vector<int>& idx, bool slope
       }
     }
     const double df = (hi_f - lo_f) / (nf - 1), rw = std::pow(hi_w / lo_w, 1.0 / (nw - 1));
-    lo_f = bf - 2 * df;
-    hi_f = bf + 2 * df;
-    lo_w = bw / (rw * rw);
-    hi_w = bw * rw * rw;
+    // In width the zoom is rw^cells: lo_w = bw / (rw * rw), hi_w = bw * rw * rw for 2 cells, the
+    // products in that order.
+    double zoom_w = 1.0;
+    hi_w = bw;
+    for (int k = 0; k < o.grid_zoom_cells; ++k) zoom_w *= rw, hi_w *= rw;
+    lo_f = bf - o.grid_zoom_cells * df;
+    hi_f = bf + o.grid_zoom_cells * df;
+    lo_w = bw / zoom_w;
   }
   return projectLinear(d, idx, bf, bw, slope, f_ref, best);
 }
@@ -308,7 +325,7 @@ ResponseData subset(const ResponseData& d, const std::vector<int>& idx) {
 /// changes branch under the step (a fold crossing it) has no derivative: its rows are left out
 /// (zero), or they would make every column the same spike.
 Eigen::MatrixXd jacobianAt(const ResponseData& d, const Layout& L, double f_ref,
-                           const std::vector<double>& x) {
+                           const std::vector<double>& x, double fold_crossing_relative_u) {
   const OutputError fn{&d, L, f_ref, BranchChoice::kNearestData};
   const int n = static_cast<int>(2 * d.size());
   Eigen::MatrixXd J(n, L.size());
@@ -317,7 +334,8 @@ Eigen::MatrixXd jacobianAt(const ResponseData& d, const Layout& L, double f_ref,
   stationaryResponse(unpack(x.data(), L, f_ref), d, &u0, nullptr, BranchChoice::kNearestData);
   for (int j = 0; j < L.size(); ++j) {
     std::vector<double> xp = x, xm = x;
-    const double h = 1e-6 * std::max(std::abs(x[j]), j < 2 ? 1e-3 * std::abs(x[0]) : 1e-6);
+    const double h =
+        kJacobianRelativeStep * std::max(std::abs(x[j]), j < 2 ? 1e-3 * std::abs(x[0]) : 1e-6);
     xp[j] += h;
     xm[j] -= h;
     const double* pp = xp.data();
@@ -327,7 +345,7 @@ Eigen::MatrixXd jacobianAt(const ResponseData& d, const Layout& L, double f_ref,
     stationaryResponse(unpack(xp.data(), L, f_ref), d, &up, nullptr, BranchChoice::kNearestData);
     stationaryResponse(unpack(xm.data(), L, f_ref), d, &um, nullptr, BranchChoice::kNearestData);
     for (size_t i = 0; i < d.size(); ++i)
-      if (std::abs(up[i] - um[i]) > 1e-3 * u0[i]) crossed[i] = true;
+      if (std::abs(up[i] - um[i]) > fold_crossing_relative_u * u0[i]) crossed[i] = true;
   }
   for (size_t i = 0; i < d.size(); ++i)
     if (crossed[i]) J.middleRows(2 * i, 2).setZero();
@@ -372,12 +390,12 @@ void normalise(const ResponseData& data_in, const ResponseFitOptions& o, FitCont
 
 /// Step 2. The lock-in's phase convention: the response turns one way through the resonance.
 /// Returns the linear fit (with a background slope) in the convention chosen.
-ResponseParams choosePhaseConvention(FitContext* c, ResponseFit* fit) {
+ResponseParams choosePhaseConvention(const ResponseFitOptions& o, FitContext* c, ResponseFit* fit) {
   ResponseParams lin, lin_conj;
-  const double rss_direct = gridLinear(c->d, c->all, true, c->f_ref, &lin);
+  const double rss_direct = gridLinear(c->d, c->all, true, c->f_ref, o, &lin);
   ResponseData dc = c->d;
   for (auto& z : dc.z) z = std::conj(z);
-  const double rss_conj = gridLinear(dc, c->all, true, c->f_ref, &lin_conj);
+  const double rss_conj = gridLinear(dc, c->all, true, c->f_ref, o, &lin_conj);
   if (rss_conj < rss_direct) {
     fit->conjugated = true;
     c->d = dc;
@@ -404,7 +422,7 @@ void chooseLayout(const ResponseTerms& terms, const ResponseFitOptions& o, FitCo
   for (const ResponseLaw& law : responseLaws()) L.terms.*law.flag = terms.*law.flag;
   {
     ResponseParams no_slope;
-    const double rss0 = gridLinear(d, c->all, false, c->f_ref, &no_slope);
+    const double rss0 = gridLinear(d, c->all, false, c->f_ref, o, &no_slope);
     const double rss1 = projectLinear(d, c->all, lin->f0_hz, lin->width_hz, true, c->f_ref, lin);
     const double rho =
         std::max(0.0, std::min(o.slope_test_max_lag1, lag1Along(d, stationaryResponse(*lin, d))));
@@ -443,7 +461,7 @@ std::vector<double> fitEachLevel(const FitContext& c,
   for (const auto& kv : by_level) {
     if (kv.second.size() < o.min_level_points) continue;
     ResponseParams p;
-    gridLinear(d, kv.second, c.L.slope, c.f_ref, &p);
+    gridLinear(d, kv.second, c.L.slope, c.f_ref, o, &p);
     const ResponseData dl = subset(d, kv.second);
     Layout lin_layout;
     lin_layout.slope = c.L.slope;
@@ -668,9 +686,10 @@ struct ScaledJacobian {
 };
 
 /// Step 11a. The Jacobian at `best`, its columns scaled to unit norm, and its SVD.
-ScaledJacobian scaledJacobianAt(const FitContext& c, const ResponseParams& best) {
+ScaledJacobian scaledJacobianAt(const FitContext& c, const ResponseParams& best,
+                                const ResponseFitOptions& o) {
   const std::vector<double> x = pack(best, c.L);
-  const Eigen::MatrixXd J = jacobianAt(c.d, c.L, c.f_ref, x);
+  const Eigen::MatrixXd J = jacobianAt(c.d, c.L, c.f_ref, x, o.fold_crossing_relative_u);
   if (J.size() == 0)
     throw AnalysisError("the fitted response cannot be evaluated near the optimum");
   ScaledJacobian sj;
@@ -936,7 +955,7 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   fit.terms = terms;
   fit.kind = o.kind;
   normalise(data_in, o, &c);
-  ResponseParams lin = choosePhaseConvention(&c, &fit);
+  ResponseParams lin = choosePhaseConvention(o, &c, &fit);
   chooseLayout(terms, o, &c, &lin, &fit);
   const std::map<double, std::vector<int>> by_level = pointsByDriveLevel(c.d, c.n);
   std::vector<double> free_abs = fitEachLevel(c, by_level, o, &fit);
@@ -952,7 +971,7 @@ ResponseFit fitResponse(const ResponseData& data_in, const ResponseTerms& terms,
   if (o.level_gain_check && by_level.size() >= 2) checkLevelGains(c, by_level, best, o, &fit);
   if (!o.intervals) return fit;
 
-  const ScaledJacobian sj = scaledJacobianAt(c, best);
+  const ScaledJacobian sj = scaledJacobianAt(c, best, o);
   markNotDetermined(c.L, sj, o, &fit);
   // Intervals. The within-sweep sandwich always; with 5 or more sweeps also a jackknife over
   // whole sweeps, whose standard error is used unless the sandwich's is larger (a refit that

@@ -48,6 +48,19 @@ TEST(ResponseFit, LinearRecordGivesF0AndQWithHonestIntervals) {
   }
 }
 
+// The start grid's sizes are options: a coarser grid (two passes, 11 x 11 after the first) still
+// starts the fit in the right basin on a clean linear record.
+TEST(ResponseFit, CoarserStartGridStillFindsTheResonance) {
+  const ResponseRecord r = simulateResponse(base(11));
+  ResponseFitOptions fo;
+  fo.grid_passes = 2;
+  fo.grid_later_frequencies = 11;
+  fo.grid_later_widths = 11;
+  const ResponseFit f = fitResponse(responseDataOf(r, fo.kind), ResponseTerms{}, fo);
+  expectCovers(f, "f0_hz", 100.0, 1e-3);
+  expectCovers(f, "Q", 100.0, 0.02);
+}
+
 TEST(ResponseFit, VelocityResponseOfALowQMode) {
   ResponseSimulatorOptions o = base(12);
   o.q = 30.0;

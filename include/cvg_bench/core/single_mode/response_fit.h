@@ -35,6 +35,37 @@ struct ResponseFitOptions {
   // Tuned thresholds of the fit's steps (response_fit.cpp; docs/response.md, "Fit"). Iteration
   // caps are Levenberg-Marquardt iterations (Ceres).
 
+  /// Start grid (variable projection over f0 and width, steps 2, 3 and 5: the linear fits for the
+  /// phase convention, the background slope and each drive level's start): passes over an
+  /// f0 x width grid, each pass around the best cell of the one before. Set by hand (commit
+  /// ea65a3c), no recorded evidence.
+  int grid_passes = 3;
+  /// Start grid: f0 values (evenly spaced) of the first pass. Set by hand (commit ea65a3c), no
+  /// recorded evidence.
+  int grid_first_frequencies = 60;
+  /// Start grid: widths (geometrically spaced) of the first pass. Set by hand (commit ea65a3c), no
+  /// recorded evidence.
+  int grid_first_widths = 30;
+  /// Start grid: f0 values of each later pass. Set by hand (commit ea65a3c), no recorded evidence.
+  int grid_later_frequencies = 21;
+  /// Start grid: widths of each later pass. Set by hand (commit ea65a3c), no recorded evidence.
+  int grid_later_widths = 21;
+  /// Start grid: a later pass spans the best cell +- this many cells of the pass before (in f0,
+  /// and as a factor step^cells in width). Set by hand (commit ea65a3c), no recorded evidence.
+  int grid_zoom_cells = 2;
+  /// Start grid: the first pass's f0 range is the points' band widened on each side by this
+  /// fraction of the band (dimensionless). Set by hand (commit ea65a3c), no recorded evidence.
+  double grid_band_margin = 0.1;
+  /// Start grid: the first pass's smallest width is the larger of this many smallest frequency
+  /// steps between consecutive points and grid_min_width_band times the band. Set by hand
+  /// (commit ea65a3c), no recorded evidence.
+  double grid_min_width_steps = 0.3;
+  /// Start grid: see grid_min_width_steps (fraction of the band). Set by hand (commit ea65a3c), no
+  /// recorded evidence.
+  double grid_min_width_band = 1e-4;
+  /// Start grid: the first pass's largest width, in bands. Set by hand (commit ea65a3c), no
+  /// recorded evidence.
+  double grid_max_width_bands = 3.0;
   /// Background slope (step 3): largest lag-1 residual correlation rho by which the F test deflates
   /// its denominator's dof, (2 n - 8) (1 - rho) / (1 + rho) (dimensionless). Set by hand (commit
   /// ea65a3c), no recorded evidence.
@@ -74,6 +105,11 @@ struct ResponseFitOptions {
   /// Another Huber round only while the new threshold is below this fraction of the last (step 8).
   /// Set by hand (commit 6574900), no recorded evidence.
   double huber_shrink_for_another_round = 0.8;
+  /// Fold crossing (step 11a): a point's rows of the Jacobian are left out (zero) when its squared
+  /// amplitude u changes by more than this fraction of itself between the +- steps of any
+  /// parameter (its root changed branch: no derivative). Set by hand (commit 1e67f1f), no recorded
+  /// evidence.
+  double fold_crossing_relative_u = 1e-3;
   /// A direction is not determined (step 11b) when its relative singular value is at most
   /// rank_tolerance times this (1e-6 with the defaults). Set by hand (commit ea65a3c), no recorded
   /// evidence.
