@@ -137,6 +137,16 @@ nlohmann::json orbitReadingToJson(const OrbitReading& m) {
   }
   j["windows"] = w;
   j["quadrature_growth"] = quadratureGrowthToJson(m.quadrature_growth);
+  auto slope = [](const ParameterEstimate& e) {
+    return e.std_error > 0.0 ? estimateWithCi(e) : nlohmann::json(nullptr);
+  };
+  j["rk_slope"] = {
+      {"what",
+       "windows' theta' [rad/s] against r k / 8 (least squares, error from the windows' "
+       "scatter, Student-t): the "
+       "coupling the record shows, and the same slope of the model's predictions"},
+      {"measured_per_s_amp2", slope(m.rk_slope_measured)},
+      {"model_per_s_amp2", slope(m.rk_slope_model)}};
   j["summary"] = m.summary;
   return j;
 }

@@ -128,6 +128,29 @@ class FoucaultRawRecord(unittest.TestCase):
         self.assertLess(w[-1]["r"], w[0]["r"])
         # Each window carries the selected model's prediction beside the measurement.
         self.assertTrue(all(x["predicted_theta_rate_deg_h"] is not None for x in w))
+        self.assertTrue(all(x["predicted_k_rate_per_s"] is not None for x in w))
+
+    def test_the_rk_coupling_and_the_ellipse_read_against_the_model(self):
+        """The pattern rate against r k / 8 over the windows (issue #25: the r k coupling the swing
+        itself shows): about 8.8e-7 1/(s px^2), where the selected output-error model's own
+        predictions give 2.8x that; and what makes the ellipse grow: the model's d|k|/dt split into
+        its parameter groups, n and the frequency split reported as one share (one swing at one
+        azimuth cannot apportion them), none determined - said, not a cause made up."""
+        ex, text = self.explain(DATA, ["--columns", COLUMNS])
+        m = ex["measured"]
+        rk = m["rk_slope"]
+        self.assertGreater(rk["measured_per_s_amp2"]["ci_low"], 6e-7)
+        self.assertLess(rk["measured_per_s_amp2"]["ci_high"], 1.2e-6)
+        self.assertGreater(rk["model_per_s_amp2"]["value"] / rk["measured_per_s_amp2"]["value"], 2.0)
+        self.assertIn("theta' against r k / 8 over the windows", text)
+        g = m["quadrature_growth"]
+        self.assertTrue(g["valid"])
+        self.assertGreater(g["measured_widening_per_s"]["value"], 0.0)  # |k| grows
+        merged = [s for s in g["shares"] if set(s["parameters"]) >= {"n", "h_c", "h_s"}]
+        self.assertEqual(len(merged), 1, g["summary"])
+        self.assertFalse(merged[0]["determined"])
+        self.assertEqual(g["named"], [])
+        self.assertIn("the record does not say what makes it", g["summary"])
 
     def test_identify_reads_the_slow_raw_record_as_explain_does(self):
         out = os.path.join(self.tmp.name, "id.json")

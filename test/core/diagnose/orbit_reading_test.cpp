@@ -51,6 +51,34 @@ TEST(OrbitReading, KnownRatesAndQWithinTheirIntervals) {
   EXPECT_GE(covered, 68) << covered << " of " << total;
 }
 
+TEST(OrbitReading, TheRkSlopeReadsACouplingOfThePatternRateToTheEllipse) {
+  // theta' = c0 + C r k / 8 with k growing from 0.01 to 0.61 and r = 1: the windows' theta'
+  // against r k / 8 has slope C (Airy's form of (5.9)); no model, so no model slope.
+  const double c0 = 1e-4, C = 2e-3, k_rate = 3e-4;
+  int covered = 0;
+  for (unsigned seed = 1; seed <= 10; ++seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, 0.002);
+    SlowRecord rec;
+    rec.omega_rad_s = 2.0;
+    for (int i = 0; i < 2000; ++i) {
+      const double t = 0.5 * i, k = 0.01 + k_rate * t;
+      // theta = integral of c0 + C k / 8 dt.
+      const double theta = -0.7 + c0 * t + C / 8.0 * (0.01 * t + 0.5 * k_rate * t * t);
+      Eigen::Vector4d q = slowFromOrbit(OrbitElements{1.0, k, theta, 0.3 * t});
+      for (int c = 0; c < 4; ++c) q[c] += noise(rng);
+      rec.t_s.push_back(t);
+      rec.q.push_back(q);
+    }
+    const OrbitReading m = readOrbit(rec, 0.0, nullptr);
+    ASSERT_TRUE(m.valid);
+    EXPECT_NEAR(m.rk_slope_measured.value, C, 0.1 * C);
+    covered += m.rk_slope_measured.ci_low <= C && C <= m.rk_slope_measured.ci_high;
+    EXPECT_EQ(m.rk_slope_model.std_error, 0.0);
+  }
+  EXPECT_GE(covered, 7);
+}
+
 TEST(OrbitReading, TooShortOrTravellingWaveSaysWhy) {
   SlowRecord rec = knownOrbit(1e-3, 1e-4, 0.0, 3);
   rec.t_s.resize(20);

@@ -38,6 +38,12 @@ struct OrbitReading {
   ParameterEstimate theta_rate;  ///< over the record (mean of the windows) [rad/s]
   ParameterEstimate k_rate;      ///< over the record [amplitude/s]
   std::string model;             ///< the model of the predictions ("" without one)
+  /// The windows' theta' against r k / 8 (the form of (5.9)'s cubic coupling; where the pattern
+  /// angle hardly moves, the anisotropy's k / r term rides along, as r changes little): the slope
+  /// the record shows [1/(s amplitude^2)], its error from the windows' scatter about the line
+  /// (Student-t, windows - 2 dof), and the same slope of the model's predictions at the windows'
+  /// states. Zero under 4 windows.
+  ParameterEstimate rk_slope_measured, rk_slope_model;
   /// With a model: what makes the ellipse's width change, at the record's median state against
   /// the measured k_rate (quadrature_growth.h); invalid without a model or its covariance.
   QuadratureGrowth quadrature_growth;
