@@ -5,9 +5,9 @@
 #include <fstream>
 #include <iostream>
 
+#include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/sample_median.h"
 #include "cvg_bench/core/io/input_checks.h"
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/model/sample_median.h"
 
 namespace cvg_bench {
 namespace report {

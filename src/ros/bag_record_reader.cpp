@@ -15,9 +15,9 @@
 #include <numeric>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/input_checks_bag.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/ros/conversions.h"
 
 namespace cvg_bench {

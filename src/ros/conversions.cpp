@@ -4,8 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/io/input_checks.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {

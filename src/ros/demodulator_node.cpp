@@ -3,7 +3,7 @@
 
 #include "cvg_bench/InputLoss.h"
 #include "cvg_bench/SlowState.h"
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/ros/conversions.h"
 
 namespace cvg_bench {

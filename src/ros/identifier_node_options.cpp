@@ -1,6 +1,6 @@
 #include "cvg_bench/ros/identifier_node_options.h"
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/simulate/experiment_runner.h"
 
 namespace cvg_bench {

@@ -9,7 +9,7 @@
 #include "cvg_bench/SimulationTruth.h"
 #include "cvg_bench/SlowState.h"
 #include "cvg_bench/SweepPoint.h"
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/simulate/experiment_runner.h"
 #include "cvg_bench/core/simulate/measurement_noise.h"
 #include "cvg_bench/core/simulate/whole_angle_simulator.h"

@@ -4,10 +4,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/free_decay_regression.h"
 #include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 

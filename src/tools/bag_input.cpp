@@ -3,7 +3,7 @@
 
 #include <iostream>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #ifdef CVG_WITH_ROSBAG
 #include "cvg_bench/core/demod/demodulator.h"
 #include "cvg_bench/ros/bag_record_reader.h"

@@ -10,7 +10,7 @@
 #include <set>
 #include <sstream>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 
 namespace cvg_bench {
 namespace tools {

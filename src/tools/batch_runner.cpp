@@ -18,7 +18,7 @@
 #include <sstream>
 #include <thread>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "json_fields.h"
 
 namespace cvg_bench {

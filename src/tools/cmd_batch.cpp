@@ -9,8 +9,8 @@
 
 #include "batch_inputs.h"
 #include "batch_runner.h"
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/model/package_resources.h"
+#include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/package_resources.h"
 #include "cvg_ident_commands.h"
 #include "fleet_drift.h"
 #include "fleet_table.h"

@@ -8,12 +8,12 @@
 
 #include "bag_input.h"
 #include "cli_args.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/demod/demodulator.h"
 #include "cvg_bench/core/demod/frequency_estimator.h"
 #include "cvg_bench/core/demod/irregular_demodulator.h"
 #include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_ident_commands.h"
 
 namespace cvg_bench {

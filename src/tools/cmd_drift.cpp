@@ -9,15 +9,15 @@
 
 #include "bag_input.h"
 #include "cli_args.h"
+#include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/package_resources.h"
 #include "cvg_bench/core/diagnose/drift_measurement.h"
 #include "cvg_bench/core/estimate/derived_quantities.h"
 #include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
 #include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"
-#include "cvg_bench/core/model/package_resources.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
 

@@ -7,11 +7,11 @@
 
 #include "bag_input.h"
 #include "cli_args.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/demod/raw_record_demodulation.h"
 #include "cvg_bench/core/diagnose/explanation.h"
 #include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_bench/report/explain_json.h"
 #include "cvg_ident_commands.h"

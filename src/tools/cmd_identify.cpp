@@ -10,10 +10,10 @@
 
 #include "bag_input.h"
 #include "cli_args.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/demod/raw_record_demodulation.h"
 #include "cvg_bench/core/estimate/identify_pipeline.h"
 #include "cvg_bench/core/io/record_io.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "cvg_ident_commands.h"
 #include "term_help.h"

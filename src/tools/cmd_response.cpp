@@ -11,8 +11,8 @@
 #include <stdexcept>
 
 #include "cli_args.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/io/response_record.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/response_simulator.h"
 #include "cvg_bench/core/single_mode/response_explain.h"
 #include "cvg_bench/core/single_mode/response_laws.h"

@@ -12,8 +12,8 @@
 
 #include "bag_input.h"
 #include "cli_args.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/io/ringdown_record.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/ringdown_simulator.h"
 #include "cvg_bench/core/single_mode/ringdown_causes.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"

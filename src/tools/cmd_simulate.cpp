@@ -3,9 +3,9 @@
 #include <sstream>
 
 #include "cli_args.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/io/input_checks.h"
 #include "cvg_bench/core/io/record_io.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_preset.h"
 #include "cvg_bench/core/simulate/experiment_runner.h"
 #include "cvg_bench/core/simulate/whole_angle_simulator.h"

@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_ident_commands.h"
 
 namespace {

@@ -9,10 +9,10 @@
 #include <iomanip>
 #include <iostream>
 
+#include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/package_resources.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
-#include "cvg_bench/core/model/package_resources.h"
 #include "cvg_bench/core/model/stationary_solver.h"
 #include "cvg_bench/report/estimate_json.h"
 

@@ -8,7 +8,7 @@
 #include <set>
 
 #include "batch_runner.h"
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "json_fields.h"
 
 namespace cvg_bench {

@@ -1,7 +1,7 @@
 // libFuzzer target: the rosbag record reader (identify/explain/demod on a .bag), every record kind.
 #include <cstdint>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/ros/bag_record_reader.h"
 #include "fuzz_input_file.h"
 

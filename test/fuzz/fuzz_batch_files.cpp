@@ -9,7 +9,7 @@
 #include "../../src/tools/batch_inputs.h"
 #include "../../src/tools/batch_runner.h"
 #include "../../src/tools/fleet_table.h"
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "fuzz_input_file.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -2,8 +2,8 @@
 #include <cstdint>
 #include <string>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/io/record_io.h"
-#include "cvg_bench/core/model/errors.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

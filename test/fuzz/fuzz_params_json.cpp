@@ -1,7 +1,7 @@
 // libFuzzer target: the `drift --params` JSON reader.
 #include <cstdint>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/report/estimate_json.h"
 #include "fuzz_input_file.h"
 

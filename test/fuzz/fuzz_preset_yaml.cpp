@@ -1,7 +1,7 @@
 // libFuzzer target: the resonator preset YAML reader (`simulate --config`).
 #include <cstdint>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/model/resonator_preset.h"
 #include "fuzz_input_file.h"
 

@@ -3,8 +3,8 @@
 #include <cstdint>
 #include <string>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/io/ringdown_record.h"
-#include "cvg_bench/core/model/errors.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

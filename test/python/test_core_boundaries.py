@@ -1,7 +1,8 @@
 """The core library stays ROS-free: no ROS header in its sources (nor in the JSON report library's),
 no catkin library on its link line; and its stage folders depend only downwards:
-model <- io <- simulate, demod <- estimate <- single_mode, diagnose (a stage includes its own folder and the
-stages before it; estimate/internal/ holds kernels any stage may use)."""
+common <- model <- io <- simulate, demod <- estimate <- single_mode, diagnose (a stage includes its own
+folder and the stages before it; common/ (errors, package resources, small numeric helpers) includes
+nothing of the core and any stage may use it; estimate/internal/ holds kernels any stage may use)."""
 import glob
 import os
 import re
@@ -12,15 +13,16 @@ ROS_INCLUDE = re.compile(r'#\s*include\s*[<"](ros|rosbag|tf2|tf2_ros|diagnostic_
                          r'geometry_msgs|cvg_bench/ros|cvg_bench/[A-Z]\w*\.h)')
 
 
-STAGE_ORDER = ["model", "io", "simulate", "demod", "estimate", "single_mode", "diagnose"]
+STAGE_ORDER = ["common", "model", "io", "simulate", "demod", "estimate", "single_mode", "diagnose"]
 ALLOWED = {
-    "model": {"model"},
-    "io": {"model", "io"},
-    "simulate": {"model", "io", "simulate"},
-    "demod": {"model", "io", "demod"},
-    "estimate": {"model", "io", "demod", "estimate"},
-    "single_mode": {"model", "io", "demod", "estimate", "single_mode"},
-    "diagnose": {"model", "io", "demod", "estimate", "diagnose"},
+    "common": {"common"},
+    "model": {"common", "model"},
+    "io": {"common", "model", "io"},
+    "simulate": {"common", "model", "io", "simulate"},
+    "demod": {"common", "model", "io", "demod"},
+    "estimate": {"common", "model", "io", "demod", "estimate"},
+    "single_mode": {"common", "model", "io", "demod", "estimate", "single_mode"},
+    "diagnose": {"common", "model", "io", "demod", "estimate", "diagnose"},
 }
 CORE_INCLUDE = re.compile(r'#\s*include\s*"cvg_bench/core/([a-z_]+)/(internal/)?')
 

@@ -11,7 +11,7 @@
 #include <fstream>
 #include <string>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/ros/conversions.h"
 
 namespace cvg_bench {

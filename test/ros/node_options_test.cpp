@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/ros/demodulator_node_options.h"
 #include "cvg_bench/ros/identifier_node_options.h"
 #include "cvg_bench/ros/simulator_node_options.h"

@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/identification.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/simulate/experiment_runner.h"
 
 namespace cvg_bench {

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/internal/simd_vector4.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

@@ -4,8 +4,8 @@
 #include <sstream>
 #include <string>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/demod/fir_lowpass.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <unsupported/Eigen/FFT>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 
 namespace cvg_bench {
 namespace {

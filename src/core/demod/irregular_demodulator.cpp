@@ -5,8 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/demod/demodulator.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {

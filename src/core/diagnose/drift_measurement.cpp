@@ -6,11 +6,11 @@
 #include <limits>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/sample_median.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"
-#include "cvg_bench/core/model/sample_median.h"
 
 namespace cvg_bench {
 

@@ -5,9 +5,9 @@
 #include <numeric>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/diagnose/low_frequency_misfit.h"
 #include "cvg_bench/core/diagnose/sweep_noise_model.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/model_term.h"
 
 namespace cvg_bench {

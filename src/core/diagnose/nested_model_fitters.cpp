@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/diagnose/candidate_extensions.h"
 #include "cvg_bench/core/diagnose/sweep_noise_model.h"
@@ -14,7 +15,6 @@
 #include "cvg_bench/core/estimate/identify_pipeline.h"
 #include "cvg_bench/core/estimate/least_squares_solver.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/resonator_model.h"
 #include "cvg_bench/core/model/stationary_solver.h"
 

@@ -4,12 +4,12 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/common/sample_median.h"
 #include "cvg_bench/core/estimate/internal/hac_slope.h"
 #include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"
-#include "cvg_bench/core/model/sample_median.h"
 
 namespace cvg_bench {
 
@@ -85,6 +85,41 @@ std::string withInterval(const ParameterEstimate& p) {
   std::ostringstream s;
   s.precision(3);
   s << p.value << " [" << p.ci_low << ", " << p.ci_high << "]";
+  return s.str();
+}
+
+/// OrbitReading::summary: one paragraph for the text report.
+std::string summaryOf(const OrbitReading& out) {
+  std::ostringstream s;
+  s.precision(4);
+  s << "measured, before any model (orbit elements (5.2) of " << out.n_samples
+    << " slow samples in " << out.windows.size() << " windows): pattern angle rate theta' "
+    << degH(out.theta_rate) << " over the record (the oscillation plane, 2 theta, turns twice as "
+    << "fast)";
+  if (!out.windows.empty()) {
+    const OrbitWindow &a = out.windows.front(), &b = out.windows.back();
+    s << ", " << degH(a.theta_rate) << " in the first window and " << degH(b.theta_rate)
+      << " in the last; amplitude r " << a.r << " -> " << b.r << ", quadrature k " << a.k << " -> "
+      << b.k;
+    if (a.q.value > 0 && b.q.value > 0)
+      s << ", Q from the amplitude decay " << a.q.value << " at r " << a.r << " -> " << b.q.value
+        << " at r " << b.r;
+    if (a.has_prediction && b.has_prediction)
+      s << "; " << out.model << " predicts theta' " << degH(a.predicted_theta_rate) << " and "
+        << degH(b.predicted_theta_rate) << " there; k' " << a.k_rate.value << " and "
+        << b.k_rate.value << " measured, " << a.predicted_k_rate.value << " and "
+        << b.predicted_k_rate.value << " predicted";
+  }
+  if (out.period_s > 0) s << "; period " << out.period_s << " s";
+  if (out.rk_slope_measured.std_error > 0.0) {
+    s << ". theta' against r k / 8 over the windows: slope " << withInterval(out.rk_slope_measured)
+      << " 1/(s amplitude^2) measured";
+    if (out.rk_slope_model.std_error > 0.0 && out.rk_slope_measured.value != 0.0)
+      s << ", " << withInterval(out.rk_slope_model) << " from " << out.model
+        << "'s predictions at the same states ("
+        << out.rk_slope_model.value / out.rk_slope_measured.value << "x)";
+  }
+  if (out.quadrature_growth.valid) s << ". Ellipse: " << out.quadrature_growth.summary;
   return s.str();
 }
 
@@ -186,37 +221,7 @@ OrbitReading readOrbit(const SlowRecord& record, double omega_rad_s, const Estim
                  th_med = std::remainder(median(th), M_PI / 2);
     out.quadrature_growth = explainQuadratureGrowth(up, r_med, k_med, th_med, out.k_rate);
   }
-  std::ostringstream s;
-  s.precision(4);
-  s << "measured, before any model (orbit elements (5.2) of " << out.n_samples
-    << " slow samples in " << out.windows.size() << " windows): pattern angle rate theta' "
-    << degH(out.theta_rate) << " over the record (the oscillation plane, 2 theta, turns twice as "
-    << "fast)";
-  if (!out.windows.empty()) {
-    const OrbitWindow &a = out.windows.front(), &b = out.windows.back();
-    s << ", " << degH(a.theta_rate) << " in the first window and " << degH(b.theta_rate)
-      << " in the last; amplitude r " << a.r << " -> " << b.r << ", quadrature k " << a.k << " -> "
-      << b.k;
-    if (a.q.value > 0 && b.q.value > 0)
-      s << ", Q from the amplitude decay " << a.q.value << " at r " << a.r << " -> " << b.q.value
-        << " at r " << b.r;
-    if (a.has_prediction && b.has_prediction)
-      s << "; " << out.model << " predicts theta' " << degH(a.predicted_theta_rate) << " and "
-        << degH(b.predicted_theta_rate) << " there; k' " << a.k_rate.value << " and "
-        << b.k_rate.value << " measured, " << a.predicted_k_rate.value << " and "
-        << b.predicted_k_rate.value << " predicted";
-  }
-  if (out.period_s > 0) s << "; period " << out.period_s << " s";
-  if (out.rk_slope_measured.std_error > 0.0) {
-    s << ". theta' against r k / 8 over the windows: slope " << withInterval(out.rk_slope_measured)
-      << " 1/(s amplitude^2) measured";
-    if (out.rk_slope_model.std_error > 0.0 && out.rk_slope_measured.value != 0.0)
-      s << ", " << withInterval(out.rk_slope_model) << " from " << out.model
-        << "'s predictions at the same states ("
-        << out.rk_slope_model.value / out.rk_slope_measured.value << "x)";
-  }
-  if (out.quadrature_growth.valid) s << ". Ellipse: " << out.quadrature_growth.summary;
-  out.summary = s.str();
+  out.summary = summaryOf(out);
   return out;
 }
 

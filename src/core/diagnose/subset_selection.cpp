@@ -22,11 +22,11 @@
 #include <map>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/diagnose/forward_selection.h"
 #include "cvg_bench/core/diagnose/nested_model_fitters.h"
 #include "cvg_bench/core/diagnose/parallel_tasks.h"
 #include "cvg_bench/core/estimate/uncertainty/long_run_variance.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 

@@ -9,6 +9,7 @@
 #include <mutex>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/collinearity.h"
 #include "cvg_bench/core/estimate/dense_solver_options.h"
@@ -21,7 +22,6 @@
 #include "cvg_bench/core/estimate/uncertainty/hac_covariance.h"
 #include "cvg_bench/core/estimate/uncertainty/residual_serial_correlation.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 

@@ -5,8 +5,8 @@
 #include <cstdio>
 #include <vector>
 
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/model/sample_median.h"
+#include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/sample_median.h"
 
 namespace cvg_bench {
 namespace {

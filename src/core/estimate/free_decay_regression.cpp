@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/internal/regression_block_ops.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

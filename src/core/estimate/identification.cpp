@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/collinearity.h"
 #include "cvg_bench/core/estimate/data_sufficiency.h"
@@ -22,7 +23,6 @@
 #include "cvg_bench/core/estimate/uncertainty/residual_serial_correlation.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/estimate/uncertainty/sweep_noise_ar1.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/stationary_solver.h"
 
 namespace cvg_bench {

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <string>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/internal/householder_panel_update.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

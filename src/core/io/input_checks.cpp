@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/model/sample_median.h"
+#include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/sample_median.h"
 
 namespace cvg_bench {
 namespace {

@@ -10,8 +10,8 @@
 #include <set>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/io/input_checks.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 

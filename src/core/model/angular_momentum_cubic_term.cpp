@@ -9,7 +9,7 @@
 
 #include <cmath>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/model/model_terms.h"
 
 namespace cvg_bench {

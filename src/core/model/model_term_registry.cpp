@@ -1,7 +1,7 @@
 #include <functional>
 #include <map>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/model/model_terms.h"
 
 namespace cvg_bench {

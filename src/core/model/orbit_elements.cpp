@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 
 namespace cvg_bench {
 namespace {

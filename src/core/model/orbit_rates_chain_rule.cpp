@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/model/model_term.h"
 
 namespace cvg_bench {

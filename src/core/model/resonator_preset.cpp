@@ -10,8 +10,8 @@
 #include <map>
 #include <set>
 
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/model/package_resources.h"
+#include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/package_resources.h"
 
 namespace cvg_bench {
 namespace {

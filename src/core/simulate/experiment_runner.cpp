@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/model/stationary_solver.h"
 #include "cvg_bench/core/simulate/averaged_model_simulator.h"
 #include "cvg_bench/core/simulate/full_equation_simulator.h"

@@ -5,8 +5,8 @@
 #include <random>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/io/ringdown_record.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"
 #include "cvg_bench/core/simulate/measurement_noise.h"
 

@@ -11,9 +11,9 @@
 #include <limits>
 #include <numeric>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/dense_solver_options.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/single_mode/response_laws.h"
 
 namespace cvg_bench {

@@ -8,7 +8,7 @@
 #include <limits>
 #include <sstream>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/single_mode/response_laws.h"
 
 namespace cvg_bench {

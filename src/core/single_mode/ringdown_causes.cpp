@@ -9,8 +9,8 @@
 #include <optional>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/uncertainty/ar_noise_covariance.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
 #include "cvg_bench/core/single_mode/ringdown_models.h"
 #include "cvg_bench/core/single_mode/ringdown_span_spread.h"

@@ -4,9 +4,9 @@
 #include <limits>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/demod/demodulator.h"
 #include "cvg_bench/core/demod/frequency_estimator.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 

@@ -6,11 +6,11 @@
 #include <limits>
 #include <sstream>
 
+#include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/sample_median.h"
 #include "cvg_bench/core/estimate/numeric_least_squares.h"
 #include "cvg_bench/core/estimate/uncertainty/ar_noise_covariance.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/model/sample_median.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
 #include "cvg_bench/core/single_mode/ringdown_laws.h"
 #include "cvg_bench/core/single_mode/ringdown_models.h"

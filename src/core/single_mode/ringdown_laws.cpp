@@ -6,8 +6,8 @@
 #include <limits>
 #include <utility>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/numeric_least_squares.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/gamma_nl_conventions.h"
 
 namespace cvg_bench {

@@ -6,8 +6,8 @@
 #include <limits>
 #include <sstream>
 
-#include "cvg_bench/core/model/errors.h"
-#include "cvg_bench/core/model/sample_median.h"
+#include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/sample_median.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
 #include "cvg_bench/core/single_mode/ringdown_models.h"
 #include "cvg_bench/core/single_mode/ringdown_record_window.h"

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "cvg_bench/core/model/sample_median.h"
+#include "cvg_bench/core/common/sample_median.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
 #include "cvg_bench/core/single_mode/ringdown_segmentation.h"
 

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <random>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/diagnose/residual_signature.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

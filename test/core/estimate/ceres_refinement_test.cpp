@@ -12,10 +12,10 @@
 #include <map>
 #include <random>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/identification.h"
 #include "cvg_bench/core/estimate/output_error_free_decay.h"
-#include "cvg_bench/core/model/errors.h"
 #include "identification_test_support.h"
 #include "paper_section4_estimate.h"
 

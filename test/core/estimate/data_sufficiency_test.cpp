@@ -8,8 +8,8 @@
 #include <cmath>
 #include <random>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/identification.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

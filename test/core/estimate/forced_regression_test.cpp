@@ -3,8 +3,8 @@
 
 #include <cmath>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/identification.h"
-#include "cvg_bench/core/model/errors.h"
 #include "identification_test_support.h"
 #include "paper_section4_estimate.h"
 

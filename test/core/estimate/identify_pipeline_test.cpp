@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/model/stationary_solver.h"
 #include "identification_test_support.h"
 #include "paper_section4_estimate.h"

@@ -7,8 +7,8 @@
 #include <Eigen/QR>
 #include <random>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

@@ -5,8 +5,8 @@
 
 #include <random>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/identification.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "identification_test_support.h"
 

@@ -4,8 +4,8 @@
 
 #include <cmath>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/derived_quantities.h"
-#include "cvg_bench/core/model/errors.h"
 #include "paper_section4_estimate.h"
 
 namespace cvg_bench {

@@ -8,8 +8,8 @@
 
 #include "../identification_test_support.h"
 #include "../paper_section4_estimate.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/identify_pipeline.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 
 namespace cvg_bench {
 namespace {

@@ -9,8 +9,8 @@
 #include <cmath>
 #include <set>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/diagnose/candidate_extensions.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/model_term.h"
 
 namespace cvg_bench {

@@ -10,7 +10,7 @@
 #include <random>
 #include <set>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/model/model_term.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "model/paper_orbit_rates.h"

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <fstream>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 
 namespace cvg_bench {
 namespace {

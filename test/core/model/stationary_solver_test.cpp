@@ -7,7 +7,7 @@
 
 #include <Eigen/LU>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "paper_section4_estimate.h"
 
 namespace cvg_bench {

@@ -8,7 +8,7 @@
 
 #include <cmath>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/simulate/averaged_model_simulator.h"
 
 namespace cvg_bench {

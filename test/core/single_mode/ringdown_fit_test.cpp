@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/simulate/ringdown_simulator.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
 

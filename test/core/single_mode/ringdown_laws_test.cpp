@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/single_mode/ringdown_causes.h"
 #include "cvg_bench/core/single_mode/ringdown_models.h"
 

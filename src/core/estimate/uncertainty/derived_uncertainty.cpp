@@ -4,9 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/derived_quantities.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"
 

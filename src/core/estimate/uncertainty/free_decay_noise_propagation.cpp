@@ -3,8 +3,8 @@
 #include <cstring>
 #include <string>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/internal/simd_vector4.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

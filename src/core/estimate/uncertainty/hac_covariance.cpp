@@ -7,8 +7,8 @@
 #include <cmath>
 #include <string>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/least_squares_solver.h"
-#include "cvg_bench/core/model/errors.h"
 
 namespace cvg_bench {
 namespace {

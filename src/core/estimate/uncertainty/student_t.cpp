@@ -5,7 +5,7 @@
 #include <cmath>
 #include <string>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 
 namespace cvg_bench {
 

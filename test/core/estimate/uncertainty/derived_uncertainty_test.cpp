@@ -5,8 +5,8 @@
 
 #include <cmath>
 
+#include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
-#include "cvg_bench/core/model/errors.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "model/paper_orbit_rates.h"
 

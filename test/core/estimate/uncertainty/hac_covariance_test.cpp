@@ -10,7 +10,7 @@
 #include <cmath>
 #include <random>
 
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 
 namespace cvg_bench {
 namespace {

@@ -1,4 +1,4 @@
-#include "cvg_bench/core/model/errors.h"
+#include "cvg_bench/core/common/errors.h"
 
 #include <cmath>
 #include <sstream>

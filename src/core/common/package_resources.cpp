@@ -1,4 +1,4 @@
-#include "cvg_bench/core/model/package_resources.h"
+#include "cvg_bench/core/common/package_resources.h"
 
 #include <algorithm>
 #include <cstdlib>
