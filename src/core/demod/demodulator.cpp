@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/internal/simd_vector4.h"
 
@@ -85,13 +86,6 @@ void mixBlock(const double* f, const double* g, size_t n, double phase0, double 
   }
 }
 
-std::string describe(double t) {
-  std::ostringstream s;
-  s.precision(15);
-  s << t;
-  return s.str();
-}
-
 }  // namespace
 
 double referencePhase(double omega_rad_s, double t_s) {
@@ -120,8 +114,8 @@ std::vector<std::string> DemodulatorOptions::validate() const {
   if (p.empty()) {
     const double f0 = omega_rad_s / (2.0 * M_PI);
     if (f0 >= 0.5 * sample_rate_hz)
-      p.push_back("reference frequency " + describe(f0) + " Hz is not below Nyquist (" +
-                  describe(0.5 * sample_rate_hz) + " Hz)");
+      p.push_back("reference frequency " + numberText(f0, 15) + " Hz is not below Nyquist (" +
+                  numberText(0.5 * sample_rate_hz, 15) + " Hz)");
     const double m = std::round(sample_rate_hz / output_rate_hz);
     if (m < 1.0) p.push_back("output_rate_hz must be <= sample_rate_hz");
     const double out = sample_rate_hz / std::max(1.0, m);
@@ -129,9 +123,9 @@ std::vector<std::string> DemodulatorOptions::validate() const {
     const double fst = stopband_hz > 0.0 ? stopband_hz : 0.5 * out;
     if (!(fst > fp)) p.push_back("stopband_hz must be > passband_hz");
     if (fst > 0.5 * out * (1.0 + 1e-12))
-      p.push_back("stopband_hz must be <= output rate / 2 (" + describe(0.5 * out) + " Hz)");
+      p.push_back("stopband_hz must be <= output rate / 2 (" + numberText(0.5 * out, 15) + " Hz)");
     if (2.0 * f0 - fst <= fst)
-      p.push_back("the mixing image at 2W (" + describe(2.0 * f0) +
+      p.push_back("the mixing image at 2W (" + numberText(2.0 * f0, 15) +
                   " Hz) is not well inside the stopband: lower the output rate");
   }
   return p;
@@ -264,18 +258,20 @@ void Demodulator::push(const double* t, const double* f, const double* g, size_t
         break;
       case RunStart::kFillMissing:
         if (!fillMissing(run, t[run.begin], out))
-          restart(std::to_string(run.missing) + " samples missing before t = " +
-                  describe(t[run.begin]) + " s and no envelope yet to fill them: filter restarted");
+          restart(std::to_string(run.missing) +
+                  " samples missing before t = " + numberText(t[run.begin], 15) +
+                  " s and no envelope yet to fill them: filter restarted");
         break;
       case RunStart::kRestartGap:
-        restart("gap before t = " + describe(t[run.begin]) + " s: filter restarted");
+        restart("gap before t = " + numberText(t[run.begin], 15) + " s: filter restarted");
         break;
       case RunStart::kRestartBad:
-        restart("out-of-range sample dropped before t = " + describe(t[run.begin]) +
+        restart("out-of-range sample dropped before t = " + numberText(t[run.begin], 15) +
                 " s: filter state cleared");
         break;
       case RunStart::kResetBackward:
-        restart("time jumped back to t = " + describe(t[run.begin]) + " s: demodulator reset");
+        restart("time jumped back to t = " + numberText(t[run.begin], 15) +
+                " s: demodulator reset");
         break;
     }
     mixAndFilter(t + run.begin, f + run.begin, g + run.begin, run.end - run.begin, out);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/diagnose/low_frequency_misfit.h"
 #include "cvg_bench/core/diagnose/sweep_noise_model.h"
 #include "cvg_bench/core/model/model_term.h"
@@ -24,19 +25,9 @@ std::vector<std::string> ExplainOptions::validate() const {
 
 namespace {
 
-std::string num(double v, int precision = 3) {
-  std::ostringstream s;
-  s.precision(precision);
-  s << v;
-  return s.str();
-}
-
 std::string pText(double p) {
   if (p < 1e-12) return "p < 1e-12";
-  std::ostringstream s;
-  s.precision(2);
-  s << "p = " << p;
-  return s.str();
+  return "p = " + numberText(p, 2);
 }
 
 /// Runs tests of several sequences, Bonferroni-combined.
@@ -50,7 +41,7 @@ LackOfFit combinedRuns(const std::string& what,
     if (r.p_value < best || lof.worst.empty()) {
       best = std::min(best, r.p_value);
       lof.worst = s.first + ": " + std::to_string(r.runs) + " runs of " + std::to_string(r.n) +
-                  " values, " + num(r.expected) + " expected";
+                  " values, " + numberText(r.expected, 3) + " expected";
     }
   }
   lof.p_value = std::min(1.0, best * static_cast<double>(seqs.size()));
@@ -106,14 +97,15 @@ std::string describeStep(const SelectionStep& s, const CandidateExtension& c, co
   o << c.cause << ": " << c.parameter << " = ";
   const auto it = fin.parameters.find(c.parameter);
   if (it != fin.parameters.end()) {
-    o << num(it->second.value, 4) << " +/- " << num(it->second.ci_high - it->second.value, 2) << " "
-      << c.unit << " (" << num(100 * fin.confidence, 3) << " % CI)";
+    o << numberText(it->second.value, 4) << " +/- "
+      << numberText(it->second.ci_high - it->second.value, 2) << " " << c.unit << " ("
+      << numberText(100 * fin.confidence, 3) << " % CI)";
   } else {
     o << "?";
   }
-  o << "; residual std " << num(sigma_before) << " -> " << num(s.sigma) << " ("
-    << num(s.sigma_ratio) << "x), F = " << num(s.wald.f_statistic, 4) << ", "
-    << pText(s.wald.p_value) << ", hold-out " << num(s.holdout_ratio) << "x better";
+  o << "; residual std " << numberText(sigma_before, 3) << " -> " << numberText(s.sigma, 3) << " ("
+    << numberText(s.sigma_ratio, 3) << "x), F = " << numberText(s.wald.f_statistic, 4) << ", "
+    << pText(s.wald.p_value) << ", hold-out " << numberText(s.holdout_ratio, 3) << "x better";
   return o.str();
 }
 
@@ -138,7 +130,7 @@ std::string amplitudeTimeCaveat(const Explanation& x, ExperimentMode mode) {
   o << " One free decay ties amplitude to time";
   if (q != e.derived.end() && q->second.value > 0.0 && e.omega_rad_s > 0.0)
     o << " (the amplitude decays as exp(-t / tau), tau = 2 Q / omega = "
-      << num(2.0 * q->second.value / e.omega_rad_s, 3) << " s)";
+      << numberText(2.0 * q->second.value / e.omega_rad_s, 3) << " s)";
   o << ": the amplitude law";
   o << (laws.size() > 1 ? "s (" : " (");
   for (size_t i = 0; i < laws.size(); ++i) o << (i ? ", " : "") << laws[i];
@@ -163,7 +155,8 @@ std::string verdict(const Explanation& x, ExperimentMode mode, const ExplainOpti
     }
   }
   if (!sel.runner_up.model.empty() && std::isfinite(sel.runner_up_delta))
-    o << " Runner-up: " << sel.runner_up.model << ", criterion " << num(sel.runner_up_delta, 3)
+    o << " Runner-up: " << sel.runner_up.model << ", criterion "
+      << numberText(sel.runner_up_delta, 3)
       << (sel.runner_up_delta >= 0 ? " worse" : " better but not confirmed by the hold-out") << ".";
   o << amplitudeTimeCaveat(x, mode);
   const Estimate& fe = x.finalEstimate();

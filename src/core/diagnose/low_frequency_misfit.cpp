@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/diagnose/model_diagnosis.h"
 #include "cvg_bench/core/diagnose/parallel_tasks.h"
 #include "cvg_bench/core/estimate/least_squares_solver.h"
@@ -75,13 +76,6 @@ Eigen::VectorXd whitenedLeastSquares(const Eigen::MatrixXd& b, const Eigen::Vect
 
 Eigen::VectorXd knownWhitened(const Eigen::VectorXd& x, const ResidualNoiseModel& known) {
   return known.ar.empty() ? x : whiten(x, 1, known);
-}
-
-std::string num(double v) {
-  std::ostringstream s;
-  s.precision(3);
-  s << v;
-  return s.str();
 }
 
 }  // namespace
@@ -165,8 +159,8 @@ LowFrequencyMisfitTest lowFrequencyMisfit(const std::vector<BlockResidual>& bloc
     r.rho_capped = r.rho_capped || capped;
     if (p < best || r.worst.empty()) {
       best = std::min(best, p);
-      r.worst = std::string(names[s]) + ": p = " + num(p) + " (AR(1) rho " + num(rho) +
-                (capped ? ", capped" : "") + ")";
+      r.worst = std::string(names[s]) + ": p = " + numberText(p, 3) + " (AR(1) rho " +
+                numberText(rho, 3) + (capped ? ", capped" : "") + ")";
     }
   }
   r.p_value = std::min(1.0, 6.0 * best);
@@ -175,7 +169,8 @@ LowFrequencyMisfitTest lowFrequencyMisfit(const std::vector<BlockResidual>& bloc
     << " in time on the trajectory residuals (radial, tangential, 4 components; Bonferroni over "
        "6), noise "
     << (known.ar.empty() ? "" : "the record's known correlation, then ")
-    << "AR(1) fitted after the smooth part is removed (rho <= " << num(options.rho_ceiling) << ")";
+    << "AR(1) fitted after the smooth part is removed (rho <= "
+    << numberText(options.rho_ceiling, 3) << ")";
   r.description = d.str();
   return r;
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/common/sample_median.h"
 #include "cvg_bench/core/estimate/internal/hac_slope.h"
 #include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
@@ -39,11 +40,8 @@ ParameterEstimate meanOfWindows(const std::vector<double>& x, double confidence)
 }
 
 std::string degH(const ParameterEstimate& p) {
-  std::ostringstream s;
-  s.precision(3);
-  s << p.value * kDegPerHour << " deg/h [" << p.ci_low * kDegPerHour << ", "
-    << p.ci_high * kDegPerHour << "]";
-  return s.str();
+  return valueWithInterval(p.value * kDegPerHour, p.ci_low * kDegPerHour, p.ci_high * kDegPerHour,
+                           3, "deg/h");
 }
 
 /// Least-squares slope of y on x with the standard error from the points' scatter about the line
@@ -82,10 +80,7 @@ void readRkSlope(OrbitReading& out, double confidence) {
 }
 
 std::string withInterval(const ParameterEstimate& p) {
-  std::ostringstream s;
-  s.precision(3);
-  s << p.value << " [" << p.ci_low << ", " << p.ci_high << "]";
-  return s.str();
+  return valueWithInterval(p.value, p.ci_low, p.ci_high, 3);
 }
 
 /// OrbitReading::summary: one paragraph for the text report.

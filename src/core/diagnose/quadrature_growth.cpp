@@ -6,6 +6,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"
 
 namespace cvg_bench {
@@ -75,10 +76,7 @@ std::vector<ParameterGroup> mergeInseparable(
 }
 
 std::string withInterval(const ParameterEstimate& e) {
-  std::ostringstream s;
-  s.precision(3);
-  s << e.value << " [" << e.ci_low << ", " << e.ci_high << "]";
-  return s.str();
+  return valueWithInterval(e.value, e.ci_low, e.ci_high, 3);
 }
 
 std::string summaryOf(const QuadratureGrowth& g, const std::string& model) {

@@ -4,21 +4,12 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/estimate/uncertainty/fitted_residual_ar1.h"
 
 namespace cvg_bench {
-namespace {
-
-std::string num(double v) {
-  std::ostringstream s;
-  s.precision(3);
-  s << v;
-  return s.str();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 ResidualNoiseModel noiseModelFromCorrelation(const std::vector<double>& rho, int max_order) {
   ResidualNoiseModel m;
@@ -44,7 +35,7 @@ ResidualNoiseModel noiseModelFromCorrelation(const std::vector<double>& rho, int
   }
   m.ar.assign(prev.begin() + 1, prev.begin() + 1 + order);
   m.rho1 = rho[0];
-  m.description = "the record's known noise correlation (rho_1 = " + num(rho[0]) + ", " +
+  m.description = "the record's known noise correlation (rho_1 = " + numberText(rho[0], 3) + ", " +
                   std::to_string(rho.size()) + " lags) as AR(" + std::to_string(order) + ")";
   return m;
 }
@@ -70,12 +61,13 @@ ResidualNoiseModel noiseModelFromResiduals(const Eigen::VectorXd& residuals, int
     rho = std::min(0.98, std::max(-0.5, rho));
   }
   if (std::abs(rho) < min_rho) {
-    m.description = "white (variogram-ratio AR(1) estimate rho = " + num(rho) + ")";
+    m.description = "white (variogram-ratio AR(1) estimate rho = " + numberText(rho, 3) + ")";
     return m;
   }
   m.ar = {rho};
   m.rho1 = rho;
-  m.description = "AR(1) fitted to the residuals (variogram ratio, rho = " + num(rho) + ")";
+  m.description =
+      "AR(1) fitted to the residuals (variogram ratio, rho = " + numberText(rho, 3) + ")";
   return m;
 }
 
@@ -123,13 +115,13 @@ ResidualNoiseModel noiseModelFromDetrendedResiduals(const Eigen::VectorXd& resid
   const bool capped = rho > ceiling;
   rho = std::min(rho, ceiling);
   if (std::abs(rho) < min_rho) {
-    m.description = "white (AR(1) of the detrended residuals rho = " + num(rho) + ")";
+    m.description = "white (AR(1) of the detrended residuals rho = " + numberText(rho, 3) + ")";
     return m;
   }
   m.ar = {rho};
   m.rho1 = rho;
   m.description = "AR(1) fitted to the residuals after Legendre P_0..P_" + std::to_string(degree) +
-                  " in time are removed (rho = " + num(rho) +
+                  " in time are removed (rho = " + numberText(rho, 3) +
                   (capped ? ", capped: the fitted value exceeds the ceiling" : "") + ")";
   return m;
 }

@@ -23,6 +23,7 @@
 #include <sstream>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/diagnose/forward_selection.h"
 #include "cvg_bench/core/diagnose/nested_model_fitters.h"
 #include "cvg_bench/core/diagnose/parallel_tasks.h"
@@ -327,13 +328,6 @@ Eigen::VectorXd adequacyVector(const NestedModelFitter& fitter, const NestedFit&
   return r;
 }
 
-std::string num(double v) {
-  std::ostringstream s;
-  s.precision(3);
-  s << v;
-  return s.str();
-}
-
 /// Every problem with the options, in one InputError.
 void throwIfInvalid(const SelectionOptions& options) {
   const auto problems = options.validate();
@@ -547,10 +541,12 @@ class SelectionRun {
   void describeCriterion() {
     std::ostringstream d;
     d << "best subset of up to " << options_.max_steps << " of " << search_.names().size()
-      << " candidates by IC = n_eff ln(RSS/N) + k max(ln n_eff, " << num(search_.penaltyFloor())
-      << "), n_eff = N / c; ranked on the equation-error LS fit (c = " << num(c_ls_) << "), the "
+      << " candidates by IC = n_eff ln(RSS/N) + k max(ln n_eff, "
+      << numberText(search_.penaltyFloor(), 3)
+      << "), n_eff = N / c; ranked on the equation-error LS fit (c = " << numberText(c_ls_, 3)
+      << "), the "
       << "linear model and " << options_.finalists << " finalists refined"
-      << (refined_scale_ ? " by the output-error fit (c = " + num(c_) + ")" : "")
+      << (refined_scale_ ? " by the output-error fit (c = " + numberText(c_, 3) + ")" : "")
       << ", confirmed on the hold-out";
     result_.criterion_description = d.str();
   }
@@ -679,7 +675,8 @@ class SelectionRun {
           if (std::find(better.begin(), better.end(), n) == better.end()) drop(n);
         if (notes_)
           notes_->push_back("backward check: " + key(best) + " -> " + key(better) + " (criterion " +
-                            num(score(best)) + " -> " + num(score(better)) + ")");
+                            numberText(score(best), 3) + " -> " + numberText(score(better), 3) +
+                            ")");
         best = better;
         shrunk = true;
       }
@@ -698,7 +695,7 @@ class SelectionRun {
       notes_->push_back("hold-out confirmation: " + key(best) +
                         " (best criterion) predicts the held-out data no better than the linear "
                         "model (ratio " +
-                        num(h) + "): not chosen");
+                        numberText(h, 3) + "): not chosen");
     return false;
   }
 

@@ -2,20 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <vector>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/common/sample_median.h"
 
 namespace cvg_bench {
 namespace {
-
-std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.3g", v);
-  return buf;
-}
 
 double median(const std::vector<double>& v) {
   return sampleMedian(v, 0.0);
@@ -72,8 +66,9 @@ DataSufficiency assessFreeDecay(const SlowRecord& record, int n_params) {
   const bool f_ok = d.snr_f >= kMinSignalToNoisePower, g_ok = d.snr_g >= kMinSignalToNoisePower;
   if (f_ok && g_ok) return d;
   d.sufficient = false;
-  const std::string figures = " (signal/noise power: f " + fmt(d.snr_f) + ", g " + fmt(d.snr_g) +
-                              "; need " + fmt(kMinSignalToNoisePower) + ")";
+  const std::string figures = " (signal/noise power: f " + printfGText(d.snr_f, 3) + ", g " +
+                              printfGText(d.snr_g, 3) + "; need " +
+                              printfGText(kMinSignalToNoisePower, 3) + ")";
   if (!f_ok && !g_ok)
     d.reason = "no decay signal above the noise: the record looks like pure noise" + figures;
   else {
@@ -104,7 +99,7 @@ DataSufficiency assessSweep(const SweepRecord& record, int n_params) {
     d.sufficient = false;
     d.reason = "the " + std::to_string(n) + " sweep points lie at " + std::to_string(distinct) +
                " distinct excitation frequenc" + (distinct == 1 ? "y" : "ies") + " (span " +
-               fmt(w.empty() ? 0.0 : w.back() - w.front()) + " rad/s; need " +
+               printfGText(w.empty() ? 0.0 : w.back() - w.front(), 3) + " rad/s; need " +
                std::to_string(kMinDistinctFrequencies) +
                "): the detuning terms of (3.4) cannot be told from the controls";
   }

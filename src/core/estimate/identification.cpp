@@ -3,9 +3,9 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/demod/demodulator_noise.h"
 #include "cvg_bench/core/estimate/collinearity.h"
 #include "cvg_bench/core/estimate/data_sufficiency.h"
@@ -79,13 +79,6 @@ std::vector<const Record*> pointersTo(const std::vector<Record>& records) {
   std::vector<const Record*> p;
   for (const auto& r : records) p.push_back(&r);
   return p;
-}
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
 }
 
 void throwIfInvalid(const IdentificationOptions& o) {
@@ -176,9 +169,9 @@ void applyRls(FirstPass& p, const LeastSquaresSolution& ls, int k, const Identif
   e->notes.push_back(
       "block RLS (2.12) with the corrected pairing y_{i+1} - D_{i+1} z_i "
       "(docs/paper.md item 9), initialised by QR on the first " +
-      std::to_string(p.m_init) + " blocks, forgetting factor " + fmt(opt.rls_forgetting) +
+      std::to_string(p.m_init) + " blocks, forgetting factor " + numberText(opt.rls_forgetting, 6) +
       "; paper's prediction bound (sigma_e = sigma) " +
-      fmt(p.filter.predictionSigmaBound(p.filter.sigma())));
+      numberText(p.filter.predictionSigmaBound(p.filter.sigma()), 6));
 }
 
 SolvedSystem solveSystem(const BlockStream& stream, const SystemInfo& info,
@@ -313,9 +306,11 @@ HonestCovariance freeDecayCovariance(const BlockStream& stream, const SystemInfo
       "rho_|m-m'| W_m W_m') C, W_m = sum_i D-bar_i' de_i/dq_m (samples shared by neighbouring "
       "equations of (2.7), docs/paper.md item 10), noise on q " +
       e->noise_model + ", sigma_q from the residuals";
-  e->notes.push_back("noise on q implied by the residuals: sigma_q = " + fmt(std::sqrt(sigma_q2)) +
-                     "; residual lag-1 correlation " + fmt(test.lag1) + " (z = " + fmt(test.z) +
-                     "; white noise on q predicts 0), lag-2 " + fmt(corr[1]) + " (white: -0.5)");
+  e->notes.push_back(
+      "noise on q implied by the residuals: sigma_q = " + numberText(std::sqrt(sigma_q2), 6) +
+      "; residual lag-1 correlation " + numberText(test.lag1, 6) +
+      " (z = " + numberText(test.z, 6) + "; white noise on q predicts 0), lag-2 " +
+      numberText(corr[1], 6) + " (white: -0.5)");
   return h;
 }
 
@@ -423,7 +418,7 @@ HonestCovariance sweepCovariance(const BlockStream& stream, const SystemInfo& in
     h.covariance = hac.covariance;
     e->interval_method_id = "hac_bartlett_andrews";
     e->noise_model = "serially correlated over the sweep points (lag-1 residual correlation " +
-                     fmt(test.lag1) + ", z = " + fmt(test.z) + ")";
+                     numberText(test.lag1, 6) + ", z = " + numberText(test.z, 6) + ")";
     e->interval_method = hac.method + " over the sweep points in order, t with G-1 dof";
     return h;
   }
@@ -555,19 +550,21 @@ std::vector<std::string> IdentificationOptions::validate() const {
   if (method != "ls" && method != "rls")
     p.push_back("method must be ls or rls (ceres: refineWithCeres), got '" + method + "'");
   if (!(confidence > 0.0 && confidence < 1.0))
-    p.push_back("confidence must lie in (0, 1), got " + fmt(confidence));
+    p.push_back("confidence must lie in (0, 1), got " + numberText(confidence, 6));
   if (!(std::isfinite(omega_rad_s) && omega_rad_s >= 0.0 && omega_rad_s <= 1e10))
-    p.push_back("omega must be in [0, 1e10] rad/s (0 = from the record), got " + fmt(omega_rad_s));
+    p.push_back("omega must be in [0, 1e10] rad/s (0 = from the record), got " +
+                numberText(omega_rad_s, 6));
   if (!(std::isfinite(angular_gain_k) && angular_gain_k > 0.0))
-    p.push_back("angular gain K must be finite and > 0, got " + fmt(angular_gain_k));
+    p.push_back("angular gain K must be finite and > 0, got " + numberText(angular_gain_k, 6));
   if (!std::isfinite(mu)) p.push_back("mu must be finite");
   if (!(rank_tolerance > 0.0 && rank_tolerance < 1.0))
-    p.push_back("rank tolerance must lie in (0, 1), got " + fmt(rank_tolerance));
+    p.push_back("rank tolerance must lie in (0, 1), got " + numberText(rank_tolerance, 6));
   if (!(uniform_time_tolerance > 0.0 && uniform_time_tolerance < 1.0))
-    p.push_back("uniform time tolerance must lie in (0, 1), got " + fmt(uniform_time_tolerance));
+    p.push_back("uniform time tolerance must lie in (0, 1), got " +
+                numberText(uniform_time_tolerance, 6));
   if (rls_init_blocks < 0) p.push_back("RLS initial blocks must be >= 0 (0 = automatic)");
   if (!(rls_forgetting > 0.0 && rls_forgetting <= 1.0))
-    p.push_back("RLS forgetting factor must lie in (0, 1], got " + fmt(rls_forgetting));
+    p.push_back("RLS forgetting factor must lie in (0, 1], got " + numberText(rls_forgetting, 6));
   if (residual_ar1_lags < 2)
     p.push_back("residual AR(1) lags must be >= 2, got " + std::to_string(residual_ar1_lags));
   return p;
@@ -594,8 +591,8 @@ void requireOneResonator(const std::vector<const SlowRecord*>& records, double o
     if (option_omega > 0.0) continue;
     const double w0 = records.front()->omega_rad_s, w = r.omega_rad_s;
     if (!std::isfinite(w) || !(std::fabs(w - w0) <= 1e-4 * std::max(std::fabs(w0), std::fabs(w))))
-      throw InputError(recordName(r, k) + ": omega " + fmt(w) + " rad/s differs from " +
-                       recordName(*records.front(), 0) + "'s " + fmt(w0) +
+      throw InputError(recordName(r, k) + ": omega " + numberText(w, 6) + " rad/s differs from " +
+                       recordName(*records.front(), 0) + "'s " + numberText(w0, 6) +
                        " rad/s by more than 100 ppm: stacked records must be of one resonator; "
                        "give their common --omega (raw records each get their own estimate)");
   }
@@ -631,8 +628,8 @@ Estimate identifyFreeDecayRecords(const std::vector<const SlowRecord*>& records,
     if (!gaps.empty()) {
       std::string where;
       for (size_t g = 0; g < gaps.size() && g < 5; ++g)
-        where +=
-            (g ? ", " : "") + fmt(rec.t_s[gaps[g]]) + " -> " + fmt(rec.t_s[gaps[g] + 1]) + " s";
+        where += (g ? ", " : "") + numberText(rec.t_s[gaps[g]], 6) + " -> " +
+                 numberText(rec.t_s[gaps[g] + 1], 6) + " s";
       info.notes.push_back(
           (rec.source.empty() ? "record " + std::to_string(r) : rec.source) + ": " +
           std::to_string(gaps.size()) + " gap(s) in time (a step over 5x the median: " + where +
@@ -697,7 +694,7 @@ Estimate identifyForcedRecords(const std::vector<const SweepRecord*>& records,
   info.notes.push_back(
       "stationary equations (3.4): y_j = ((omega0^2 - omega^2)/omega0) (p1, -q1, "
       "p2, -q2) (exact detuning rate, docs/paper.md item 7), omega = " +
-      fmt(info.omega_rad_s) + " rad/s, known mu = " + fmt(options.mu));
+      numberText(info.omega_rad_s, 6) + " rad/s, known mu = " + numberText(options.mu, 6));
   info.notes.push_back(
       "equation-error LS puts the noisy q inside D: biased ~ sigma_q^2 (docs/paper.md "
       "item 15); --method ceres removes it");

@@ -1,9 +1,9 @@
 #include "cvg_bench/core/estimate/identify_pipeline.h"
 
 #include <cmath>
-#include <sstream>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/model/resonator_model.h"
 
 namespace cvg_bench {
@@ -63,12 +63,6 @@ Estimate refine(const Record& record, const Estimate& start, const PipelineOptio
     if (o.on_ceres_failure == CeresFailure::kThrow) throw;
     return keptStart(start, err);
   }
-}
-
-std::string fmtMu(double mu) {
-  std::ostringstream s;
-  s << std::fixed << mu;  // std::to_string's format, kept for the tool's notes
-  return s.str();
 }
 
 }  // namespace
@@ -138,7 +132,8 @@ Estimate identify(const SweepRecord& record, const PipelineOptions& options) {
   linear.model = model.linearPart().spec();
   Estimate start = identifyForced(record, linear);
   start.model = model.spec();
-  start.notes.push_back("Ceres start: LS with mu = " + fmtMu(options.identification.mu));
+  // std::to_string's format, kept for the tool's notes
+  start.notes.push_back("Ceres start: LS with mu = " + fixedText(options.identification.mu, 6));
   return refine(record, start, options);
 }
 

@@ -4,23 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/common/sample_median.h"
 
 namespace cvg_bench {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string fmt(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.6g", v);
-  return buf;
-}
 
 double median(const std::vector<double>& v) {
   return sampleMedian(v, 0.0);
@@ -30,8 +24,9 @@ double median(const std::vector<double>& v) {
 
 void requireOmegaInRange(double omega_rad_s, const std::string& what) {
   if (!std::isfinite(omega_rad_s) || !(omega_rad_s > 0.0) || omega_rad_s > kMaxOmegaRadS)
-    throw InputError(what + ": omega " + fmt(omega_rad_s) + " rad/s is out of range (must be > 0 " +
-                     "and <= " + fmt(kMaxOmegaRadS) + " rad/s)");
+    throw InputError(what + ": omega " + printfGText(omega_rad_s, 6) +
+                     " rad/s is out of range (must be > 0 " +
+                     "and <= " + printfGText(kMaxOmegaRadS, 6) + " rad/s)");
 }
 
 void requireInputFile(const std::string& path, const std::string& what) {
@@ -67,12 +62,12 @@ void checkStateColumns(const std::vector<std::pair<std::string, const std::vecto
     const std::vector<double>& v = *c.second;
     for (size_t r = 0; r < n; ++r) {
       if (!std::isfinite(v[r]))
-        throw InputError(where(r, c.first) + "column '" + c.first + "': " + fmt(v[r]) +
+        throw InputError(where(r, c.first) + "column '" + c.first + "': " + printfGText(v[r], 6) +
                          " is not finite");
       if (std::fabs(v[r]) > kMaxStateMagnitude)
-        throw InputError(where(r, c.first) + "column '" + c.first + "': " + fmt(v[r]) +
-                         " [record units] is out of range (|value| > " + fmt(kMaxStateMagnitude) +
-                         ")");
+        throw InputError(where(r, c.first) + "column '" + c.first + "': " + printfGText(v[r], 6) +
+                         " [record units] is out of range (|value| > " +
+                         printfGText(kMaxStateMagnitude, 6) + ")");
       row_max[r] = std::max(row_max[r], std::fabs(v[r]));
     }
   }
@@ -83,10 +78,11 @@ void checkStateColumns(const std::vector<std::pair<std::string, const std::vecto
     const std::vector<double>& v = *c.second;
     for (size_t r = 0; r < n; ++r) {
       if (std::fabs(v[r]) > limit)
-        throw InputError(where(r, c.first) + "column '" + c.first + "': " + fmt(v[r]) +
-                         " [record units] is " + fmt(std::fabs(v[r]) / typical) +
-                         " times the record's typical magnitude " + fmt(typical) + " (limit " +
-                         fmt(kMaxStateOverTypical) + "x): a corrupted sample");
+        throw InputError(where(r, c.first) + "column '" + c.first + "': " + printfGText(v[r], 6) +
+                         " [record units] is " + printfGText(std::fabs(v[r]) / typical, 6) +
+                         " times the record's typical magnitude " + printfGText(typical, 6) +
+                         " (limit " + printfGText(kMaxStateOverTypical, 6) +
+                         "x): a corrupted sample");
     }
   }
 }
@@ -95,8 +91,8 @@ void checkTimeColumn(const std::vector<double>& t_s, const std::string& name,
                      const RowLocator& where) {
   for (size_t r = 0; r < t_s.size(); ++r) {
     if (!std::isfinite(t_s[r]) || std::fabs(t_s[r]) > kMaxTimeS)
-      throw InputError(where(r, name) + "time " + fmt(t_s[r]) +
-                       " s is out of range (|t| <= " + fmt(kMaxTimeS) + " s)");
+      throw InputError(where(r, name) + "time " + printfGText(t_s[r], 6) +
+                       " s is out of range (|t| <= " + printfGText(kMaxTimeS, 6) + " s)");
   }
   if (t_s.size() < 3) return;
   std::vector<double> dt(t_s.size() - 1);
@@ -105,10 +101,10 @@ void checkTimeColumn(const std::vector<double>& t_s, const std::string& name,
   if (!(typical > 0.0)) return;
   for (size_t r = 1; r < t_s.size(); ++r) {
     if (dt[r - 1] > kMaxIntervalOverMedian * typical)
-      throw InputError(where(r, name) + "time jumps by " + fmt(dt[r - 1]) +
-                       " s from the previous " + "sample, " + fmt(dt[r - 1] / typical) +
-                       " times the median interval " + fmt(typical) + " s (limit " +
-                       fmt(kMaxIntervalOverMedian) + "x): a clock jump");
+      throw InputError(where(r, name) + "time jumps by " + printfGText(dt[r - 1], 6) +
+                       " s from the previous " + "sample, " + printfGText(dt[r - 1] / typical, 6) +
+                       " times the median interval " + printfGText(typical, 6) + " s (limit " +
+                       printfGText(kMaxIntervalOverMedian, 6) + "x): a clock jump");
   }
 }
 
@@ -117,9 +113,9 @@ void checkExcitationColumn(const std::vector<double>& omega0_rad_s, const std::s
   for (size_t r = 0; r < omega0_rad_s.size(); ++r) {
     const double w = omega0_rad_s[r];
     if (!std::isfinite(w) || !(w > 0.0) || w > kMaxOmegaRadS)
-      throw InputError(where(r, name) + "column '" + name + "': " + fmt(w) +
-                       " rad/s is out of range (must be > 0 and <= " + fmt(kMaxOmegaRadS) +
-                       " rad/s)");
+      throw InputError(where(r, name) + "column '" + name + "': " + printfGText(w, 6) +
+                       " rad/s is out of range (must be > 0 and <= " +
+                       printfGText(kMaxOmegaRadS, 6) + " rad/s)");
   }
 }
 

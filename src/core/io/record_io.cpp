@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/io/input_checks.h"
 
 namespace cvg_bench {
@@ -31,12 +32,6 @@ std::string trim(const std::string& s) {
   if (b == std::string::npos) return "";
   const auto e = s.find_last_not_of(" \t\r");
   return s.substr(b, e - b + 1);
-}
-
-std::string formatDouble(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
 }
 
 /// Cells of one row as [begin, end) offsets into the line (no allocation per cell).
@@ -199,9 +194,9 @@ void requireIncreasing(const Table& table, int col) {
   const auto& t = table.columns[col];
   for (size_t i = 1; i < t.size(); ++i) {
     if (t[i] > t[i - 1]) continue;
-    throw InputError(table.where(table.row_line[i], col + 1) + "time " + formatDouble(t[i]) +
+    throw InputError(table.where(table.row_line[i], col + 1) + "time " + printfGText(t[i], 17) +
                      (t[i] == t[i - 1] ? " repeats" : " is before") + " the previous row's " +
-                     formatDouble(t[i - 1]) + " (line " + std::to_string(table.row_line[i - 1]) +
+                     printfGText(t[i - 1], 17) + " (line " + std::to_string(table.row_line[i - 1]) +
                      "): timestamps must increase strictly");
   }
 }
@@ -250,7 +245,7 @@ std::vector<int> flagColumn(const Table& table, const std::string& name,
     // Range check first: a flag like 7.8e27 is integral but no int (UB to convert).
     if (v != std::round(v) || std::abs(v) > 1e6 || !allowed.count(static_cast<int>(v)))
       throw InputError(table.where(table.row_line[r], c + 1) + "column '" + name +
-                       "': " + formatDouble(v) + " is not one of the allowed flags");
+                       "': " + printfGText(v, 17) + " is not one of the allowed flags");
     out.push_back(static_cast<int>(v));
   }
   return out;
@@ -261,7 +256,7 @@ SweepRecord toSweep(const Table& table) {
   for (size_t r = 0; r < table.row_line.size(); ++r) {
     if (table.columns[io][r] <= 0.0)
       throw InputError(table.where(table.row_line[r], io + 1) + "omega0 " +
-                       formatDouble(table.columns[io][r]) + " must be > 0 [rad/s]");
+                       printfGText(table.columns[io][r], 17) + " must be > 0 [rad/s]");
   }
   checkExcitationColumn(table.columns[io], "omega0", table.locator());
   table.checkStates({"q1", "p1", "q2", "p2"});
@@ -339,7 +334,7 @@ std::string readFile(const std::string& path) {
 
 void writeHeaderLines(std::ostream& out, double omega, const std::string& mode,
                       const RecordMetadata& metadata) {
-  if (omega > 0.0) out << "# omega: " << formatDouble(omega) << "\n";
+  if (omega > 0.0) out << "# omega: " << printfGText(omega, 17) << "\n";
   out << "# mode: " << mode << "\n";
   for (const auto& kv : metadata) {
     if (kv.first == "omega" || kv.first == "mode") continue;
@@ -367,7 +362,7 @@ void writeRows(std::ostream& out, const std::string& header, const ExtraColumns&
   for (size_t i = 0; i < n; ++i) {
     line.clear();
     row(i, line);
-    for (const auto& kv : extra) line += "," + formatDouble(kv.second[i]);
+    for (const auto& kv : extra) line += "," + printfGText(kv.second[i], 17);
     line += "\n";
     out << line;
   }

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/model/stationary_solver.h"
 #include "cvg_bench/core/simulate/averaged_model_simulator.h"
 #include "cvg_bench/core/simulate/full_equation_simulator.h"
@@ -12,12 +12,6 @@
 
 namespace cvg_bench {
 namespace {
-
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof(buf), "%.17g", v);
-  return buf;
-}
 
 /// The forced truth model with its parameters and the amplitude scale |u~| / gamma.
 struct ForcedSystem {
@@ -121,9 +115,9 @@ void addTruthMetadata(const ResonatorPreset& preset, const ResonatorModel& model
   md["preset"] = preset.name;
   md["truth_model"] = model.spec();
   const auto values = model.parameterValues(z);
-  for (const auto& kv : values) md["truth_" + kv.first] = num(kv.second);
-  if (model.mode() == ExperimentMode::kForced) md["truth_mu"] = num(preset.mu);
-  md["truth_eta"] = num(preset.eta);
+  for (const auto& kv : values) md["truth_" + kv.first] = printfGText(kv.second, 17);
+  if (model.mode() == ExperimentMode::kForced) md["truth_mu"] = printfGText(preset.mu, 17);
+  md["truth_eta"] = printfGText(preset.eta, 17);
 }
 
 }  // namespace
@@ -143,7 +137,7 @@ Eigen::Vector4d ExperimentRunner::stationaryForcedState(double lambda,
   const Settled s = settle(sys, lambda, start, preset_.sweep_settle_tolerance,
                            50.0 * preset_.sweep_settle_time_s);
   if (!s.settled)
-    throw AnalysisError("the forced oscillation at detuning " + num(lambda) +
+    throw AnalysisError("the forced oscillation at detuning " + printfGText(lambda, 17) +
                         " rad/s did not become stationary");
   return s.q;
 }
@@ -311,7 +305,7 @@ AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOpti
   const double q_std = options.noise_std >= 0.0 ? options.noise_std : preset.noise_q_std;
   const double fg_std = options.noise_std >= 0.0 ? options.noise_std : preset.noise_fg_std;
   RecordMetadata md;
-  md["omega"] = num(preset.omega_rad_s);
+  md["omega"] = printfGText(preset.omega_rad_s, 17);
   md["mode"] = experimentModeName(mode);
   addTruthMetadata(preset, model, z, md);
   md["seed"] = std::to_string(options.seed);
@@ -320,16 +314,18 @@ AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOpti
     const OrbitElements& start = options.free_decay_start;
     Eigen::Vector4d q0;
     if (start.r == 0.0) {
-      md["drive_detuning_rad_s"] = num(preset.decay_drive_detuning_rad_s);
+      md["drive_detuning_rad_s"] = printfGText(preset.decay_drive_detuning_rad_s, 17);
       q0 = runner.freeDecayInitialState();
     } else {
       if (!(std::isfinite(start.r) && start.r > 0.0 && std::isfinite(start.k) &&
             std::abs(start.k) <= start.r && std::isfinite(start.theta) && std::isfinite(start.chi)))
         throw InputError("free-decay start: need r > 0, |k| <= r, finite theta and chi, got r = " +
-                         num(start.r) + ", k = " + num(start.k) + ", theta = " + num(start.theta) +
-                         ", chi = " + num(start.chi));
-      md["free_decay_start"] = "r " + num(start.r) + ", k " + num(start.k) + ", theta_rad " +
-                               num(start.theta) + ", chi_rad " + num(start.chi);
+                         printfGText(start.r, 17) + ", k = " + printfGText(start.k, 17) +
+                         ", theta = " + printfGText(start.theta, 17) +
+                         ", chi = " + printfGText(start.chi, 17));
+      md["free_decay_start"] = "r " + printfGText(start.r, 17) + ", k " + printfGText(start.k, 17) +
+                               ", theta_rad " + printfGText(start.theta, 17) + ", chi_rad " +
+                               printfGText(start.chi, 17);
       q0 = slowFromOrbit(start);
     }
     if (options.raw) {
@@ -337,7 +333,7 @@ AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOpti
       out.kind = RecordKind::kRaw;
       out.raw = runner.freeDecayRaw(d, q0);
       noise.addTo(out.raw, fg_std);
-      md["noise_std"] = num(fg_std);
+      md["noise_std"] = printfGText(fg_std, 17);
       md["integrator"] = "full equations (2.3), RK4 in osculating variables, " +
                          std::to_string(preset.steps_per_period) + " steps per period";
       out.raw.metadata = md;
@@ -346,7 +342,7 @@ AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOpti
       out.kind = RecordKind::kFreeDecay;
       out.slow = runner.freeDecaySlow(d, q0);
       noise.addTo(out.slow, q_std);
-      md["noise_std"] = num(q_std);
+      md["noise_std"] = printfGText(q_std, 17);
       md["integrator"] = "averaged model (2.6), Dormand-Prince 5(4)";
       out.slow.metadata = md;
     }
@@ -362,17 +358,17 @@ AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOpti
   md["n_unsettled"] = std::to_string(sweep.n_unsettled);
   std::string jumps;
   for (const auto& s : sweep.steps)
-    if (s.jump) jumps += (jumps.empty() ? "" : " ") + num(s.lambda_rad_s);
+    if (s.jump) jumps += (jumps.empty() ? "" : " ") + printfGText(s.lambda_rad_s, 17);
   if (!jumps.empty()) md["jump_lambdas_rad_s"] = jumps;
   if (sweep.has_hysteresis)
-    md["hysteresis_lambda_range_rad_s"] =
-        num(sweep.hysteresis_lambda_min_rad_s) + " " + num(sweep.hysteresis_lambda_max_rad_s);
+    md["hysteresis_lambda_range_rad_s"] = printfGText(sweep.hysteresis_lambda_min_rad_s, 17) + " " +
+                                          printfGText(sweep.hysteresis_lambda_max_rad_s, 17);
   if (options.raw) {
     const double d = options.duration_s > 0 ? options.duration_s : preset.sweep_raw_duration_s;
     out.kind = RecordKind::kRaw;
     out.raw = runner.forcedSweepRaw(sweep, d);
     noise.addTo(out.raw, fg_std);
-    md["noise_std"] = num(fg_std);
+    md["noise_std"] = printfGText(fg_std, 17);
     md["integrator"] = "full equations (3.1), RK4 in osculating variables at omega0, " +
                        std::to_string(preset.steps_per_period) + " steps per period";
     md["layout"] =
@@ -385,7 +381,7 @@ AnyRecord simulateExperiment(const ResonatorPreset& preset, const SimulationOpti
   out.sweep = sweepRecordOf(sweep, preset.omega_rad_s);
   SweepRecord& rec = out.sweep;
   noise.addTo(rec, q_std);
-  md["noise_std"] = num(q_std);
+  md["noise_std"] = printfGText(q_std, 17);
   md["integrator"] = "averaged model (3.3) settled per step, Newton-polished";
   rec.metadata = md;
   return out;

@@ -2,9 +2,9 @@
 
 #include <array>
 #include <cmath>
-#include <sstream>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"
 #include "cvg_bench/core/simulate/measurement_noise.h"
 
@@ -26,16 +26,7 @@ double defaultWalk(const ResonatorModel& model, const ResonatorPreset& preset,
 
 }  // namespace
 
-namespace {
-
-std::string num(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
-
-}  // namespace
+namespace {}  // namespace
 
 SlowRecord simulateWholeAngle(const ResonatorPreset& preset, const WholeAngleOptions& o) {
   requirePositive(o.r0, "whole-angle amplitude r0");
@@ -89,18 +80,19 @@ SlowRecord simulateWholeAngle(const ResonatorPreset& preset, const WholeAngleOpt
   }
   MeasurementNoise noise(o.seed);
   noise.addTo(rec, o.noise_std >= 0.0 ? o.noise_std : preset.noise_q_std);
-  rec.metadata["omega"] = num(preset.omega_rad_s);
+  rec.metadata["omega"] = numberText(preset.omega_rad_s, 17);
   rec.metadata["mode"] = "free_decay";
   rec.metadata["experiment"] = "whole_angle";
-  rec.metadata["whole_angle_r0"] = num(o.r0);
-  rec.metadata["whole_angle_k0"] = num(o.k0);
+  rec.metadata["whole_angle_r0"] = numberText(o.r0, 17);
+  rec.metadata["whole_angle_k0"] = numberText(o.k0, 17);
   rec.metadata["whole_angle_loops"] =
-      ideal ? "ideal (r and k held exactly)" : "proportional, gain " + num(g) + " 1/s";
-  rec.metadata["whole_angle_walk_rad_s"] = num(walk);
+      ideal ? "ideal (r and k held exactly)" : "proportional, gain " + numberText(g, 17) + " 1/s";
+  rec.metadata["whole_angle_walk_rad_s"] = numberText(walk, 17);
   rec.metadata["preset"] = preset.name;
   rec.metadata["seed"] = std::to_string(o.seed);
   rec.metadata["truth_model"] = model.spec();
-  for (const auto& kv : preset.parameters) rec.metadata["truth_" + kv.first] = num(kv.second);
+  for (const auto& kv : preset.parameters)
+    rec.metadata["truth_" + kv.first] = numberText(kv.second, 17);
   return rec;
 }
 

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <boost/math/distributions/students_t.hpp>
 #include <cmath>
-#include <cstdio>
 
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/single_mode/response_laws.h"
 
 namespace cvg_bench {
@@ -45,12 +45,6 @@ size_t selectCandidate(const std::vector<ResponseCandidate>& candidates) {
     }
   }
   return pick;
-}
-
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), f, v);
-  return buf;
 }
 
 }  // namespace
@@ -99,16 +93,16 @@ ResponseExplanation explainResponse(const ResponseData& data, const ResponseExpl
   std::string v = x.unexplained
                       ? "unexplained: the drive levels differ in a way no amplitude law "
                         "of the model follows (RSS " +
-                            fmt("%.3g", x.adequacy_ratio) +
+                            printfGText(x.adequacy_ratio, 3) +
                             "x that with a free drive factor per level); best model " + x.selected
                       : x.selected;
   auto d = [&](const char* k) { return sel.derived.at(k).value; };
-  v += "; f0 " + fmt("%.8g", d("f0_hz")) + " Hz, width " + fmt("%.4g", d("width_hz")) + " Hz, Q " +
-       fmt("%.4g", d("Q"));
+  v += "; f0 " + printfGText(d("f0_hz"), 8) + " Hz, width " + printfGText(d("width_hz"), 4) +
+       " Hz, Q " + printfGText(d("Q"), 4);
   for (const ResponseLaw& law : responseLaws())
     if (sel.terms.*law.flag)
       v += std::string("; ") + law.verdict_words(d(law.derived_key)) + " " +
-           fmt("%.4g", d(law.derived_key)) + " " + law.unit;
+           printfGText(d(law.derived_key), 4) + " " + law.unit;
   if (sel.jumps > 0) v += "; " + std::to_string(sel.jumps) + " jumps reproduced by the branch";
   x.verdict = v;
   return x;

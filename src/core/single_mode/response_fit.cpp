@@ -7,11 +7,11 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <numeric>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/estimate/dense_solver_options.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/single_mode/response_laws.h"
@@ -45,13 +45,6 @@ constexpr double kRefineGradientTolerance = 1e-14;
 /// Numerical setting: jacobianAt's central-difference step, this fraction of each parameter's
 /// magnitude (at least of 1e-3 |f0| for f0 and width, of 1e-6 for the others).
 constexpr double kJacobianRelativeStep = 1e-6;
-
-/// `v` as printf's %g (the notes' numbers of options).
-std::string fmtG(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
 
 /// Parameter vector: f0, w0, Re a, Im a, Re b0, Im b0, [Re b1, Im b1], then the nonlinear terms'
 /// coefficients in the registry's order (response_laws.h): [xi], [g].
@@ -646,7 +639,7 @@ void fillPointEstimates(const FitContext& c, const ResponseParams& best, double 
   int far = 0;
   for (size_t i = 0; i < n; ++i) far += std::abs(d.z[i] - m[i]) > delta ? 1 : 0;
   fit->notes.push_back("Huber weights beyond " + std::to_string(delta * zs) + " (" +
-                       fmtG(o.huber_noise_scales) +
+                       printfGText(o.huber_noise_scales, 6) +
                        " scales of the noise or of the median misfit): " + std::to_string(far) +
                        " of " + std::to_string(n) + " points down-weighted");
   fit->sigma = std::sqrt(fit->rss / std::max(1, static_cast<int>(2 * n) - L.size()));

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/estimate/uncertainty/ar_noise_covariance.h"
 #include "cvg_bench/core/single_mode/ringdown_envelope.h"
 #include "cvg_bench/core/single_mode/ringdown_models.h"
@@ -38,13 +39,6 @@ constexpr double kDerivativeStep = 1e-6;
 double chi2Upper(int df, double x) {
   if (!(x > 0.0)) return 1.0;
   return boost::math::cdf(boost::math::complement(boost::math::chi_squared(df), x));
-}
-
-std::string fmt(double v, int prec = 4) {
-  std::ostringstream s;
-  s.precision(prec);
-  s << v;
-  return s.str();
 }
 
 /// Physical plausibility (sign checks) of an extension's fit (its law's check); returns "" when
@@ -425,14 +419,15 @@ void compareLawsThroughFilter(ExplainState& st) {
       if (sc == 1.0) {
         if (fb.ok) x.law_choice_sse[fb.model] = fb.sse_whitened;
         if (fr.ok) x.law_choice_sse[fr.model] = fr.sse_whitened;
-        w << " from " << fmt(fb.t_start_s) << " s (drive-off fitted at " << fmt(fb.drive_off_s)
-          << " s, " << fb.n << " samples)";
+        w << " from " << numberText(fb.t_start_s, 4) << " s (drive-off fitted at "
+          << numberText(fb.drive_off_s, 4) << " s, " << fb.n << " samples)";
       }
       const bool flip = pr && (!pb || fr.sse_whitened < fb.sse_whitened);
       votes += flip;
-      w << "; AR-whitened SSE " << fb.model << " " << (fb.ok ? fmt(fb.sse_whitened) : "n/a")
-        << (pb ? "" : " (negative damping)") << ", " << fr.model << " "
-        << (fr.ok ? fmt(fr.sse_whitened) : "n/a") << (pr ? "" : " (negative damping)");
+      w << "; AR-whitened SSE " << fb.model << " "
+        << (fb.ok ? numberText(fb.sse_whitened, 4) : "n/a") << (pb ? "" : " (negative damping)")
+        << ", " << fr.model << " " << (fr.ok ? numberText(fr.sse_whitened, 4) : "n/a")
+        << (pr ? "" : " (negative damping)");
     }
     w << " -> " << (votes == kFilterScaleCount ? st.steps[rival].added : st.steps[best].added)
       << (votes == kFilterScaleCount ? " at every filter"
@@ -541,7 +536,7 @@ bool confirmCandidate(ExplainState& st, HoldOutRivals* rivals, int k) {
       isAmplitudeLaw(s.added) ? options.hold_out_factor_amplitude : options.hold_out_factor_shape;
   if (!(s.hold_out_error < factor * cv_rival)) {
     s.note = "not confirmed on hold-out (blocked two-fold prediction error " +
-             fmt(s.hold_out_error) + " vs " + fmt(cv_rival) + ")";
+             numberText(s.hold_out_error, 4) + " vs " + numberText(cv_rival, 4) + ")";
     return false;
   }
   if (ringdownLaw(s.added).q_checked_against_baseline) {
@@ -549,9 +544,9 @@ bool confirmCandidate(ExplainState& st, HoldOutRivals* rivals, int k) {
     if (qe != st.fits[k].derived.end() && ql != x.baseline.derived.end()) {
       const double ratio = qe->second.value / ql->second.value;
       if (!(ratio < options.q_factor && ratio > 1.0 / options.q_factor)) {
-        s.note = "Q " + fmt(qe->second.value) + " against the single exponential's " +
-                 fmt(ql->second.value) + " over the same span (a factor over " +
-                 fmt(options.q_factor) + "): not the decay read off the record";
+        s.note = "Q " + numberText(qe->second.value, 4) + " against the single exponential's " +
+                 numberText(ql->second.value, 4) + " over the same span (a factor over " +
+                 numberText(options.q_factor, 4) + "): not the decay read off the record";
         return false;
       }
     }
@@ -673,8 +668,7 @@ bool judgeFinalFit(ExplainState& st, const RingdownStep* pick) {
 std::string qText(const RingdownFit& fin, const std::string& k) {
   const auto it = fin.derived.find(k);
   if (it == fin.derived.end()) return std::string("n/a (no frequency)");
-  return fmt(it->second.value) + " [" + fmt(it->second.ci_low) + ", " + fmt(it->second.ci_high) +
-         "]";
+  return valueWithInterval(it->second.value, it->second.ci_low, it->second.ci_high, 4);
 }
 
 /// The sentence of an accepted extension `added` with the final fit `fin`: its law's cause_text
@@ -696,7 +690,7 @@ void describeExtension(std::ostringstream& cs, const std::string& added, const R
         key.size() > kValueOnly.size() &&
         key.compare(key.size() - kValueOnly.size(), std::string::npos, kValueOnly) == 0;
     if (value_only)
-      cs << fmt(fin.derived.at(key.substr(0, key.size() - kValueOnly.size())).value);
+      cs << numberText(fin.derived.at(key.substr(0, key.size() - kValueOnly.size())).value, 4);
     else
       cs << qText(fin, key);
     at = close + 1;
@@ -711,9 +705,9 @@ void writeCause(ExplainState& st, const RingdownStep* best_step, bool negative) 
   const auto& fin = x.final_fit;
   if (x.segment.has_floor) {
     x.causes.push_back("noise_floor");
-    cs << "Noise floor at " << fmt(x.segment.floor_log_amplitude * kDbPerNeper) << " dB from "
-       << fmt(x.segment.floor_start_s) << " s: the fit stops " << fmt(x.segment.floor_margin_db)
-       << " dB above it. ";
+    cs << "Noise floor at " << numberText(x.segment.floor_log_amplitude * kDbPerNeper, 4)
+       << " dB from " << numberText(x.segment.floor_start_s, 4) << " s: the fit stops "
+       << numberText(x.segment.floor_margin_db, 4) << " dB above it. ";
   }
   if (x.segment.n_dropouts_in_span > 0) {
     x.causes.push_back("drop_outs");
@@ -728,7 +722,7 @@ void writeCause(ExplainState& st, const RingdownStep* best_step, bool negative) 
     x.causes.push_back("unexplained");
     cs << "Unexplained: the decay rate changes along the record without a physical damping law"
        << (st.negative_law.empty()
-               ? std::string(" (lack-of-fit p = " + fmt(x.lack_of_fit_p, 2) + ")")
+               ? std::string(" (lack-of-fit p = " + numberText(x.lack_of_fit_p, 2) + ")")
                : std::string(" (an amplitude law fits only with a negative "
                              "coefficient: the decay accelerates as it falls)"))
        << ": drift of the mode out of the detection band or loss of detection; this Q is not "
@@ -737,10 +731,11 @@ void writeCause(ExplainState& st, const RingdownStep* best_step, bool negative) 
   if (!best_step && !x.unexplained)
     cs << "A single exponential decay explains the envelope: Q = " << qText(fin, "Q") << ". ";
   if (!x.unexplained && x.lack_of_fit_p < options.alpha)
-    cs << "The residuals still curve (lack-of-fit p = " << fmt(x.lack_of_fit_p, 2)
+    cs << "The residuals still curve (lack-of-fit p = " << numberText(x.lack_of_fit_p, 2)
        << "), but the local decay rate wanders by only "
-       << fmt(100.0 * x.lack_of_fit_rate_variation, 2)
-       << " % (RMS) of its mean along the span (under " << fmt(100.0 * options.rate_variation, 2)
+       << numberText(100.0 * x.lack_of_fit_rate_variation, 2)
+       << " % (RMS) of its mean along the span (under "
+       << numberText(100.0 * options.rate_variation, 2)
        << " %): one Q describes it to that precision. ";
   if (negative) cs << "A fitted damping is negative: not an adequate model. ";
   x.cause = cs.str();

@@ -6,16 +6,10 @@
 #include <cmath>
 #include <sstream>
 
+#include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/estimate/uncertainty/fitted_residual_ar1.h"
 
 namespace cvg_bench {
-namespace {
-std::string num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-}  // namespace
 
 SweepAr1 sweepNoiseAr1(const std::vector<Eigen::Vector4d>& r, const std::vector<double>& amp2,
                        const std::vector<double>& abscissa, const SweepNoiseOptions& options) {
@@ -75,7 +69,8 @@ SweepAr1 sweepNoiseAr1(const std::vector<Eigen::Vector4d>& r, const std::vector<
   out.rho = rho;
   d << "AR(1) along the sweep, rho " << rho << (out.capped ? " (capped)" : "")
     << (options.upper_standard_errors > 0.0 ? " (estimate + " : "")
-    << (options.upper_standard_errors > 0.0 ? num(options.upper_standard_errors) + " SE)" : "")
+    << (options.upper_standard_errors > 0.0 ? numberText(options.upper_standard_errors, 6) + " SE)"
+                                            : "")
     << ", from the " << n << " quiet points (amplitude^2 <= " << options.quiet_fraction
     << " x the largest) of the output-error residuals after Legendre P_0..P_" << k - 1
     << " in the drive frequency";
