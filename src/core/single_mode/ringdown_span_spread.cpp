@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "cvg_bench/core/common/errors.h"
+#include "cvg_bench/core/estimate/uncertainty/student_t.h"
 
 namespace cvg_bench {
 
@@ -30,19 +31,21 @@ void addSpanSpread(const RingdownEnvelope& env, const RingdownSegment& seg,
     s.t_end_s = env.t_s[s.i_end - 1];
     try {
       const RingdownFit f = fitRingdown(env, s, fit->model, o);
+      std::vector<double> d(names.size());
       for (size_t k = 0; k < names.size(); ++k) {
         const auto it = f.derived.find(names[k]);
         if (it == f.derived.end() || !std::isfinite(it->second.value)) throw AnalysisError("no Q");
-        const double d = it->second.value - fit->derived[names[k]].value;
-        sum2[k] += d * d;
+        d[k] = it->second.value - fit->derived[names[k]].value;
       }
+      // Only a neighbour that gave every value counts (its Q is not added without its Q0).
+      for (size_t k = 0; k < names.size(); ++k) sum2[k] += d[k] * d[k];
       ++used;
     } catch (const AnalysisError&) {
       // A neighbouring span that does not fit adds nothing; at least three are needed.
     }
   }
   if (used < spread.min_fits) return;
-  const double z = spread.z;
+  const double z = studentQuantile(options.confidence, 0);  // normal: the span part has no dof
   for (size_t k = 0; k < names.size(); ++k) {
     RingdownValue& v = fit->derived[names[k]];
     v.std_span = std::sqrt(sum2[k] / used);

@@ -4,8 +4,10 @@
 // is refitted on four neighbouring spans (start 10 % and 20 % of the span later, end 10 % and
 // 20 % earlier) and the spread of Q over the five fits is the span part:
 //   std_span = sqrt(sum_k (Q_k - Q)^2 / 4),  std_total = sqrt(std^2 + std_span^2),
-// and the total interval is Q exp(+-z std_total / Q) (never negative, never of zero width),
-// widened to the within-record interval where that is wider (an open bound stays open).
+// and the total interval is Q exp(+-z std_total / Q) with z the normal quantile of the fit's
+// confidence (never negative, never of zero width), widened to the within-record interval where
+// that is wider (an open bound stays open). std_span divides by the neighbouring fits that gave
+// every reported value (four when all fit).
 #pragma once
 
 #include <cstddef>
@@ -27,9 +29,6 @@ struct RingdownSpanSpreadOptions {
   double far_cut = 0.2;
   /// Neighbouring fits needed (of four) for a span part [1]. No recorded evidence.
   int min_fits = 3;
-  /// Quantile of the total interval: the normal 97.5 % point (a 95 % two-sided interval),
-  /// fixed; it does not follow RingdownFitOptions::confidence. No recorded evidence.
-  double z = 1.959963984540054;
 };
 
 /// Adds std_span, std_total and the total interval to fit->derived["Q"] (and Q0 where present).
