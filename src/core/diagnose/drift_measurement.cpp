@@ -8,6 +8,7 @@
 
 #include "cvg_bench/core/common/errors.h"
 #include "cvg_bench/core/common/sample_median.h"
+#include "cvg_bench/core/estimate/internal/centred_line_fit.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
 #include "cvg_bench/core/model/orbit_elements.h"
 #include "cvg_bench/core/model/orbit_rates_chain_rule.h"
@@ -159,25 +160,16 @@ struct PassSet {
 void fitPass(const PatternTrack& p, size_t start, size_t end, int b, double walk_rad_s,
              PassSet* set) {
   const int n = static_cast<int>(end - start);
-  double tm = 0.0, ym = 0.0;
-  for (size_t j = start; j < end; ++j) tm += p.t[j], ym += p.th[j];
-  tm /= n;
-  ym /= n;
-  double sxx = 0.0, sxy = 0.0;
-  for (size_t j = start; j < end; ++j) {
-    sxx += (p.t[j] - tm) * (p.t[j] - tm);
-    sxy += (p.t[j] - tm) * (p.th[j] - ym);
-  }
-  const double slope = sxy / sxx;
+  const CentredLineFit f = centredLineFit(&p.t[start], &p.th[start], end - start);
   double prev = 0.0;
   for (size_t j = start; j < end; ++j) {
-    const double e = p.th[j] - ym - slope * (p.t[j] - tm);
+    const double e = f.residual(p.t[j], p.th[j]);
     set->sse += e * e;
     if (j > start) set->lag1 += e * prev;
     prev = e;
   }
   set->noise_dof += n - 2;
-  set->passes.push_back({b, slope - walk_rad_s, sxx});
+  set->passes.push_back({b, f.slope - walk_rad_s, f.sxx});
 }
 
 /// Cuts the run into runs of consecutive samples whose selection angle lies in one bin; those

@@ -6,6 +6,7 @@
 
 #include "cvg_bench/core/common/number_text.h"
 #include "cvg_bench/core/common/sample_median.h"
+#include "cvg_bench/core/estimate/internal/centred_line_fit.h"
 #include "cvg_bench/core/estimate/internal/hac_slope.h"
 #include "cvg_bench/core/estimate/uncertainty/derived_uncertainty.h"
 #include "cvg_bench/core/estimate/uncertainty/student_t.h"
@@ -51,17 +52,13 @@ std::string degH(const ParameterEstimate& p) {
 ParameterEstimate scatterSlope(const std::vector<double>& x, const std::vector<double>& y,
                                double confidence) {
   const size_t n = x.size();
-  if (n < 4) return {};
-  double mx = 0.0, my = 0.0;
-  for (size_t i = 0; i < n; ++i) mx += x[i] / n, my += y[i] / n;
-  double sxx = 0.0, sxy = 0.0;
-  for (size_t i = 0; i < n; ++i) sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
-  if (!(sxx > 0.0)) return {};
-  const double b = sxy / sxx;
+  if (n < 4 || y.size() != n) return {};
+  const CentredLineFit f = centredLineFit(x.data(), y.data(), n);
+  if (!(f.sxx > 0.0)) return {};
   double sse = 0.0;
-  for (size_t i = 0; i < n; ++i) sse += std::pow(y[i] - my - b * (x[i] - mx), 2);
+  for (size_t i = 0; i < n; ++i) sse += std::pow(f.residual(x[i], y[i]), 2);
   const double dof = static_cast<double>(n) - 2.0;
-  return interval(b, sse / dof / sxx, studentQuantile(confidence, static_cast<int>(dof)));
+  return interval(f.slope, sse / dof / f.sxx, studentQuantile(confidence, static_cast<int>(dof)));
 }
 
 /// OrbitReading::rk_slope_*: the windows' theta' (measured, and predicted where every window has
